@@ -1,0 +1,60 @@
+# povpress build.  `make` builds build/povpress; `make check` runs the unit
+# and end-to-end tests; `make bench` measures analysis throughput.
+
+CC      ?= cc
+CFLAGS  ?= -O3 -g
+WARN     = -std=c11 -Wall -Wextra -Wpedantic -Wshadow -Wstrict-prototypes
+CPPFLAGS += -D_POSIX_C_SOURCE=200809L -I. $(shell pkg-config --cflags OpenEXR 2>/dev/null)
+EXR_LIBS = $(shell pkg-config --libs-only-L OpenEXR 2>/dev/null) -lOpenEXRCore-3_1
+LDLIBS  += -lpthread -lm
+
+BUILD = build
+
+REG_SRC = $(wildcard regression/*.c)
+DRV_SRC = $(wildcard driver/*.c)
+REG_OBJ = $(REG_SRC:%.c=$(BUILD)/%.o)
+DRV_OBJ = $(DRV_SRC:%.c=$(BUILD)/%.o)
+LIB_DRV_OBJ = $(filter-out $(BUILD)/driver/main.o,$(DRV_OBJ))
+
+UNIT_SRC = $(wildcard tests/test_*.c)
+UNIT_BIN = $(UNIT_SRC:tests/%.c=$(BUILD)/tests/%)
+TOOL_BIN = $(BUILD)/tests/gen_image $(BUILD)/bench/bench_analyze
+
+.PHONY: all check unit e2e bench clean deps
+all: $(BUILD)/povpress
+
+$(BUILD)/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -MMD -MP -c $< -o $@
+
+$(BUILD)/povpress: $(REG_OBJ) $(DRV_OBJ)
+	$(CC) $(CFLAGS) -o $@ $^ $(EXR_LIBS) $(LDLIBS)
+
+$(BUILD)/tests/test_%: $(BUILD)/tests/test_%.o $(REG_OBJ) $(LIB_DRV_OBJ)
+	$(CC) $(CFLAGS) -o $@ $^ -lcmocka $(EXR_LIBS) $(LDLIBS)
+
+$(BUILD)/tests/gen_image: $(BUILD)/tests/gen_image.o $(LIB_DRV_OBJ) $(REG_OBJ)
+	$(CC) $(CFLAGS) -o $@ $^ $(EXR_LIBS) $(LDLIBS)
+
+$(BUILD)/bench/bench_analyze: $(BUILD)/scripts/bench_analyze.o $(REG_OBJ)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
+
+deps:
+	scripts/install-deps.sh
+
+unit: $(UNIT_BIN)
+	@set -e; for t in $(UNIT_BIN); do echo "== $$t"; $$t; done
+
+e2e: $(BUILD)/povpress $(BUILD)/tests/gen_image
+	tests/e2e.sh $(BUILD)
+
+check: unit e2e
+
+bench: $(BUILD)/bench/bench_analyze
+	$(BUILD)/bench/bench_analyze
+
+clean:
+	rm -rf $(BUILD)
+
+-include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

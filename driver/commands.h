@@ -1,0 +1,17 @@
+/*
+ * commands.h - the povpress subcommands.
+ *
+ * Each takes the arguments after "povpress" (argv[0] is the command's own
+ * name), does its own printing, and returns the process exit code: 0 on
+ * success, 1 on a runtime error, 2 on a usage error.
+ */
+#ifndef POVPRESS_COMMANDS_H
+#define POVPRESS_COMMANDS_H
+
+/* povpress analyze IN.exr -o OUT.exr: the regression's analysis of an image. */
+int cmd_analyze(int argc, char **argv);
+
+/* povpress compare IMAGE.exr REF.exr: print relMSE, MSE and PSNR. */
+int cmd_compare(int argc, char **argv);
+
+#endif

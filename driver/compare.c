@@ -1,0 +1,110 @@
+/*
+ * compare.c - "povpress compare": error of an image against a reference.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "driver/commands.h"
+#include "driver/image.h"
+#include "driver/metrics.h"
+
+static const char compare_usage[] =
+	"usage: povpress compare IMAGE.exr REF.exr\n"
+	"\n"
+	"Print the error of IMAGE against the reference REF over the R, G, B\n"
+	"channels (a lone Y channel stands for all three):\n"
+	"\n"
+	"  relmse: V   mean of (x - ref)^2 / (ref^2 + 0.01)\n"
+	"  mse: V      mean of (x - ref)^2\n"
+	"  psnr: V     10 log10(1 / mse), peak 1; inf when mse is 0\n"
+	"\n"
+	"Pixels that are NaN or infinite in either image are left out, and a\n"
+	"fourth line \"skipped: N\" counts them.\n";
+
+/* Read path and reduce it to R, G, B; prints the error itself. */
+static int load_rgb(const char *path, struct image *rgb)
+{
+	struct image img;
+	char err[1024];
+	int rc;
+
+	if (image_read_exr(path, &img, err, sizeof(err))) {
+		fprintf(stderr, "povpress compare: %s\n", err);
+		return -1;
+	}
+	rc = image_rgb(&img, path, rgb, err, sizeof(err));
+	image_release(&img);
+	if (rc)
+		fprintf(stderr, "povpress compare: %s\n", err);
+	return rc;
+}
+
+int cmd_compare(int argc, char **argv)
+{
+	struct image img = { 0 }, ref = { 0 };
+	const char *paths[2];
+	struct metrics m;
+	char err[1024];
+	int npaths = 0, options_done = 0, ret = 1;
+
+	for (int i = 1; i < argc; i++) {
+		const char *arg = argv[i];
+
+		if (!options_done && arg[0] == '-' && arg[1]) {
+			if (!strcmp(arg, "--")) {
+				options_done = 1;
+				continue;
+			}
+			if (!strcmp(arg, "--help") || !strcmp(arg, "-h")) {
+				fputs(compare_usage, stdout);
+				return 0;
+			}
+			fprintf(stderr, "povpress compare: unknown option '%s'\n\n", arg);
+			fputs(compare_usage, stderr);
+			return 2;
+		}
+		if (npaths == 2) {
+			fprintf(stderr, "povpress compare: too many arguments\n\n");
+			fputs(compare_usage, stderr);
+			return 2;
+		}
+		paths[npaths++] = arg;
+	}
+	if (npaths != 2) {
+		fputs(compare_usage, stderr);
+		return 2;
+	}
+
+	if (load_rgb(paths[0], &img) || load_rgb(paths[1], &ref))
+		goto out;
+	if (img.w != ref.w || img.h != ref.h) {
+		fprintf(stderr, "povpress compare: '%s' is %dx%d but '%s' is %dx%d\n",
+			paths[0], img.w, img.h, paths[1], ref.w, ref.h);
+		goto out;
+	}
+	if (metrics_compute(&img, &ref, &m, err, sizeof(err))) {
+		fprintf(stderr, "povpress compare: cannot compare '%s' with '%s': %s\n",
+			paths[0], paths[1], err);
+		goto out;
+	}
+
+	printf("relmse: %.6g\n", m.relmse);
+	printf("mse: %.6g\n", m.mse);
+	if (isinf(m.psnr))
+		printf("psnr: inf\n");
+	else
+		printf("psnr: %.6g\n", m.psnr);
+	if (m.skipped)
+		printf("skipped: %zu\n", m.skipped);
+	if (fflush(stdout) || ferror(stdout)) {
+		fprintf(stderr, "povpress compare: cannot write output: %s\n", strerror(errno));
+		goto out;
+	}
+	ret = 0;
+out:
+	image_release(&img);
+	image_release(&ref);
+	return ret;
+}

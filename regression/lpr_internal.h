@@ -1,0 +1,64 @@
+/* lpr_internal.h - what the modules of regression/ share with each other. */
+#ifndef LPR_INTERNAL_H
+#define LPR_INTERNAL_H
+
+#include "regression/lpr.h"
+
+#define LPR_NORDERS 3
+
+/* Number of spatial columns of a polynomial of the given order. */
+static inline int lpr_nspatial(int order)
+{
+	return order == 0 ? 1 : order == 1 ? 3 : 6;
+}
+
+/* 1 when every channel of pixel i of img (and of feat, if any) is finite. */
+int lpr_sample_valid(const struct lpr_image *img, const struct lpr_image *feat, size_t i);
+
+/*
+ * General-path fits at pixel (x, y) with radius r for orders 0 .. maxorder,
+ * sharing one pass over the window; out[o] receives order o.  unmasked says
+ * the clipped window holds no missing sample, which allows the moments to
+ * be computed from separable sums (it is ignored when feat is set).
+ */
+void lpr_general_fits(const struct lpr_image *img, const struct lpr_image *feat,
+		      int x, int y, int r, int maxorder, int unmasked, struct lpr_fit *out);
+
+#endif
+
+/* Per-candidate results for the rows of one strip; NaN marks "no fit". */
+struct lpr_cand_buf {
+	float *fit, *dx, *dy;   /* npx * nch */
+	float *lev, *e2, *q;    /* npx: H_cc, PRESS term e^2, noise term */
+};
+
+/*
+ * The fixed filters of an unmasked interior window of radius r, without
+ * features (see fastpath.c).
+ */
+struct lpr_filters {
+	int r;
+	double t[2 * LPR_MAXRADIUS + 1];   /* 1-D tricube weights */
+	double tu[2 * LPR_MAXRADIUS + 1];  /* t * u */
+	double tu2[2 * LPR_MAXRADIUS + 1]; /* t * u^2 */
+	double s;          /* sum of t */
+	double c0, c3, c5; /* centre row of the order-2 inverse moment matrix */
+	double h0, h2;     /* centre leverages of orders 0 and 2 */
+	double v0, v2;     /* leave-one-out prediction variance factors */
+	double gscale;     /* slope = gscale * sum W u Y */
+};
+
+void lpr_filters_init(struct lpr_filters *f, int r);
+
+/* Scratch the fast path needs for a strip of nrows rows, in doubles. */
+size_t lpr_fast_scratch(int w, int nch, int nrows, int r);
+
+/*
+ * Fit every pixel of rows [ya, yb) whose elig flag is 1 (elig is indexed
+ * from row ya), from clean (the image with holes replaced by 0), writing
+ * the order-0, -1 and -2 candidates into c[0..2] (an entry may be NULL).
+ * Buffers are indexed from row ya.  Returns the number of pixels fitted.
+ */
+long lpr_fast_strip(const struct lpr_filters *f, const float *clean, int w, int h,
+		    int nch, int ya, int yb, const unsigned char *elig,
+		    double *scratch, struct lpr_cand_buf *const c[LPR_NORDERS]);

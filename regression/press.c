@@ -1,0 +1,562 @@
+/*
+ * press.c - per-pixel model selection by PRESS over whole images.
+ *
+ * The image is cut into strips of STRIP_ROWS rows; threads take strips in
+ * turn, each with its own scratch, and every strip is computed the same way
+ * whichever thread takes it, so the output does not depend on the number of
+ * threads.  For a strip, every candidate (order, radius) is fitted on the
+ * strip's rows plus a margin of smooth_radius rows, on the fast path where
+ * the window is interior and unmasked and on the general path elsewhere.
+ * The PRESS terms e^2 of each candidate are then averaged over a tricube
+ * neighbourhood (holes and unfittable pixels left out), and each pixel takes
+ * the candidate with the smallest average.
+ */
+#include "regression/lpr_internal.h"
+#include "regression/kernel.h"
+
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define STRIP_ROWS 64
+#define MAXCAND (LPR_NORDERS * 8)
+
+struct cand {
+	int order, ri;
+};
+
+struct shared {
+	const struct lpr_image *img, *feat;
+	const struct lpr_params *p;
+	struct lpr_result *out;
+	int ncand;
+	struct cand cand[MAXCAND];        /* in order of preference */
+	int candidx[LPR_NORDERS][8];      /* (order, radius index) -> cand, or -1 */
+	int nr, maxorder, s;
+	struct lpr_filters filt[8];
+	float *clean;                     /* holes replaced by 0 */
+	int *sat;                         /* summed-area table of invalid pixels */
+	unsigned char *valid;
+	int nstrips, next, failed;
+	long fast, general;
+	pthread_mutex_t lock;
+};
+
+struct worker {
+	struct shared *sh;
+	size_t npx;
+	float *store;
+	struct lpr_cand_buf buf[MAXCAND];
+	unsigned char *elig;
+	double *fscratch;
+	float *hn;          /* smoothing: 3 horizontal sums per pixel */
+	float *pad;         /* smoothing: 3 padded rows */
+	float *cv, *qs;     /* smoothed PRESS and noise, STRIP_ROWS * w per cand */
+	long fast, general;
+};
+
+static void seterr(char *err, size_t len, const char *fmt, ...)
+{
+	if (!err || !len)
+		return;
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(err, len, fmt, ap);
+	va_end(ap);
+}
+
+void lpr_params_init(struct lpr_params *p)
+{
+	memset(p, 0, sizeof *p);
+	p->order = -1;
+	p->radius = 0;
+	p->nradii = 4;
+	p->radii[0] = 2;
+	p->radii[1] = 3;
+	p->radii[2] = 5;
+	p->radii[3] = 8;
+	p->smooth_radius = 2;
+	p->tie_tol = 0.02;
+	p->nthreads = 0;
+}
+
+void lpr_result_release(struct lpr_result *r)
+{
+	if (!r)
+		return;
+	free(r->fit);
+	free(r->dx);
+	free(r->dy);
+	free(r->leverage);
+	free(r->error);
+	free(r->order);
+	free(r->bandwidth);
+	memset(r, 0, sizeof *r);
+}
+
+static int invalid_in(const struct shared *sh, int x0, int y0, int x1, int y1)
+{
+	/* Count of invalid pixels in [x0, x1] x [y0, y1]. */
+	const int *s = sh->sat;
+	size_t W = (size_t)sh->img->w + 1;
+	return s[(size_t)(y1 + 1) * W + x1 + 1] - s[(size_t)y0 * W + x1 + 1] -
+	       s[(size_t)(y1 + 1) * W + x0] + s[(size_t)y0 * W + x0];
+}
+
+static void write_general(struct lpr_cand_buf *b, size_t i, int nch, const struct lpr_fit *f)
+{
+	for (int c = 0; c < nch; c++) {
+		b->fit[i * nch + c] = f->valid ? (float)f->fit[c] : NAN;
+		b->dx[i * nch + c] = f->valid ? (float)f->dx[c] : NAN;
+		b->dy[i * nch + c] = f->valid ? (float)f->dy[c] : NAN;
+	}
+	b->lev[i] = f->valid ? (float)f->leverage : NAN;
+	b->e2[i] = f->valid ? (float)f->press : NAN;
+	b->q[i] = f->valid ? (float)f->noise : NAN;
+}
+
+/* Fit every candidate on rows [ya, yb). */
+static void fit_rows(struct worker *wk, int ya, int yb)
+{
+	struct shared *sh = wk->sh;
+	const struct lpr_image *img = sh->img;
+	const int w = img->w, h = img->h, nch = img->nch;
+	int use_fast = !sh->feat && !sh->p->force_general;
+
+	for (int ri = 0; ri < sh->nr; ri++) {
+		const struct lpr_filters *f = &sh->filt[ri];
+		const int r = f->r;
+		struct lpr_cand_buf *cb[LPR_NORDERS];
+		for (int o = 0; o < LPR_NORDERS; o++)
+			cb[o] = sh->candidx[o][ri] >= 0 ? &wk->buf[sh->candidx[o][ri]] : NULL;
+
+		/* elig: 1 fast path, 2 clipped but unmasked, 0 general. */
+		for (int y = ya; y < yb; y++)
+			for (int x = 0; x < w; x++) {
+				int x0 = x - r < 0 ? 0 : x - r, x1 = x + r >= w ? w - 1 : x + r;
+				int y0 = y - r < 0 ? 0 : y - r, y1 = y + r >= h ? h - 1 : y + r;
+				int clean = !invalid_in(sh, x0, y0, x1, y1);
+				int inside = x0 == x - r && x1 == x + r && y0 == y - r && y1 == y + r;
+				unsigned char e = clean ? (inside && use_fast ? 1 : 2) : 0;
+				wk->elig[(size_t)(y - ya) * w + x] = e;
+			}
+		if (use_fast)
+			wk->fast += lpr_fast_strip(f, sh->clean, w, h, nch, ya, yb, wk->elig,
+						   wk->fscratch, cb);
+		int maxo = sh->maxorder < 1 ? 1 : sh->maxorder;
+		for (int y = ya; y < yb; y++)
+			for (int x = 0; x < w; x++) {
+				size_t i = (size_t)(y - ya) * w + x;
+				if (wk->elig[i] == 1)
+					continue;
+				struct lpr_fit fits[LPR_NORDERS];
+				lpr_general_fits(img, sh->feat, x, y, r, maxo,
+						 wk->elig[i] == 2 && !sh->p->force_general, fits);
+				for (int o = 0; o < LPR_NORDERS; o++)
+					if (cb[o])
+						write_general(cb[o], i, nch, &fits[o]);
+				wk->general++;
+			}
+	}
+}
+
+/*
+ * Average e2 and q of candidate b over the tricube neighbourhood of radius
+ * s, leaving out entries that are not finite; rows [y0, y1) of the output,
+ * from the fitted rows [ya, yb).
+ */
+static void smooth(struct worker *wk, const struct lpr_cand_buf *b, int ya, int yb,
+		   int y0, int y1, float *cv, float *qs)
+{
+	const int w = wk->sh->img->w, s = wk->sh->s;
+	double td[2 * LPR_MAXRADIUS + 1];
+	float t[2 * LPR_MAXRADIUS + 1];
+	kernel_weights(s, td);
+	for (int i = 0; i <= 2 * s; i++)
+		t[i] = (float)td[i];
+	float *hn = wk->hn;
+	const size_t plane = (size_t)(yb - ya) * w;
+	/* Padded copies of one row: values where finite, else 0, and the
+	 * 0/1 mask, so that the horizontal sums need no tests. */
+	float *pe = wk->pad, *pq = pe + w + 2 * s, *pm = pq + w + 2 * s;
+	for (int i = 0; i < s; i++)
+		pe[i] = pq[i] = pm[i] = pe[w + s + i] = pq[w + s + i] = pm[w + s + i] = 0.0f;
+	for (int y = ya; y < yb; y++) {
+		size_t row = (size_t)(y - ya) * w;
+		for (int x = 0; x < w; x++) {
+			float e = b->e2[row + x];
+			int ok = isfinite(e);
+			pe[x + s] = ok ? e : 0.0f;
+			pq[x + s] = ok ? b->q[row + x] : 0.0f;
+			pm[x + s] = ok ? 1.0f : 0.0f;
+		}
+		float *he = hn + row, *hq = hn + plane + row, *hm = hn + 2 * plane + row;
+		for (int x = 0; x < w; x++)
+			he[x] = hq[x] = hm[x] = 0.0f;
+		for (int i = 0; i <= 2 * s; i++) {
+			float ti = t[i];
+			for (int x = 0; x < w; x++) {
+				he[x] += ti * pe[x + i];
+				hq[x] += ti * pq[x + i];
+				hm[x] += ti * pm[x + i];
+			}
+		}
+	}
+	float *ae = wk->pad, *aq = ae + w, *am = aq + w;
+	for (int y = y0; y < y1; y++) {
+		int j0 = y - s < ya ? ya - y : -s, j1 = y + s >= yb ? yb - 1 - y : s;
+		for (int x = 0; x < w; x++)
+			ae[x] = aq[x] = am[x] = 0.0f;
+		for (int j = j0; j <= j1; j++) {
+			size_t k = (size_t)(y + j - ya) * w;
+			float tj = t[j + s];
+			const float *he = hn + k, *hq = hn + plane + k, *hm = hn + 2 * plane + k;
+			for (int x = 0; x < w; x++) {
+				ae[x] += tj * he[x];
+				aq[x] += tj * hq[x];
+				am[x] += tj * hm[x];
+			}
+		}
+		size_t o = (size_t)(y - y0) * w;
+		for (int x = 0; x < w; x++) {
+			cv[o + x] = am[x] > 0.0f ? ae[x] / am[x] : NAN;
+			qs[o + x] = am[x] > 0.0f ? aq[x] / am[x] : NAN;
+		}
+	}
+}
+
+static void select_rows(struct worker *wk, int ya, int y0, int y1)
+{
+	struct shared *sh = wk->sh;
+	const struct lpr_image *img = sh->img;
+	const int w = img->w, nch = img->nch;
+	const size_t sp = (size_t)STRIP_ROWS * w;
+	struct lpr_result *out = sh->out;
+	const double tol = sh->p->tie_tol;
+
+	for (int y = y0; y < y1; y++)
+		for (int x = 0; x < w; x++) {
+			size_t li = (size_t)(y - ya) * w + x;   /* fitted-rows index */
+			size_t si = (size_t)(y - y0) * w + x;   /* strip index */
+			size_t gi = (size_t)y * w + x;          /* image index */
+			int best = -1, first = -1;
+			double bestcv = 0.0, floor_ = 0.0;
+			for (int k = 0; k < sh->ncand; k++) {
+				if (!isfinite(wk->buf[k].fit[li * nch]))
+					continue;
+				if (first < 0) {
+					first = k;
+					double m2 = 0.0;
+					for (int c = 0; c < nch; c++) {
+						double v = wk->buf[k].fit[li * nch + c];
+						m2 += v * v;
+					}
+					/* Differences below float resolution are ties. */
+					floor_ = 1e-12 * m2 / nch;
+				}
+				double cv = wk->cv[k * sp + si];
+				if (!isfinite(cv))
+					continue;
+				if (best < 0 || cv < bestcv * (1.0 - tol) - floor_) {
+					best = k;
+					bestcv = cv;
+				}
+			}
+			int k = best >= 0 ? best : first;
+			if (k >= 0) {
+				const struct lpr_cand_buf *b = &wk->buf[k];
+				for (int c = 0; c < nch; c++) {
+					out->fit[gi * nch + c] = b->fit[li * nch + c];
+					out->dx[gi * nch + c] = b->dx[li * nch + c];
+					out->dy[gi * nch + c] = b->dy[li * nch + c];
+				}
+				out->leverage[gi] = b->lev[li];
+				out->order[gi] = (float)sh->cand[k].order;
+				if (best >= 0) {
+					out->error[gi] = wk->qs[k * sp + si];
+					out->bandwidth[gi] = (float)sh->filt[sh->cand[k].ri].r;
+				} else {
+					out->error[gi] = 0.0f;
+					out->bandwidth[gi] = 0.0f;
+				}
+			} else {
+				/* Nothing to fit: keep the sample, or NaN for a hole. */
+				int ok = sh->valid[gi];
+				for (int c = 0; c < nch; c++) {
+					out->fit[gi * nch + c] = ok ? img->px[gi * nch + c] : NAN;
+					out->dx[gi * nch + c] = ok ? 0.0f : NAN;
+					out->dy[gi * nch + c] = ok ? 0.0f : NAN;
+				}
+				out->leverage[gi] = ok ? 1.0f : NAN;
+				out->error[gi] = ok ? 0.0f : NAN;
+				out->order[gi] = 0.0f;
+				out->bandwidth[gi] = 0.0f;
+			}
+		}
+}
+
+static void *work(void *arg)
+{
+	struct worker *wk = arg;
+	struct shared *sh = wk->sh;
+	for (;;) {
+		pthread_mutex_lock(&sh->lock);
+		int st = sh->next++;
+		pthread_mutex_unlock(&sh->lock);
+		if (st >= sh->nstrips)
+			break;
+		int h = sh->img->h, w = sh->img->w;
+		int y0 = st * STRIP_ROWS, y1 = y0 + STRIP_ROWS > h ? h : y0 + STRIP_ROWS;
+		int ya = y0 - sh->s < 0 ? 0 : y0 - sh->s, yb = y1 + sh->s > h ? h : y1 + sh->s;
+		fit_rows(wk, ya, yb);
+		const size_t sp = (size_t)STRIP_ROWS * w;
+		for (int k = 0; k < sh->ncand; k++)
+			smooth(wk, &wk->buf[k], ya, yb, y0, y1, wk->cv + k * sp, wk->qs + k * sp);
+		select_rows(wk, ya, y0, y1);
+	}
+	return NULL;
+}
+
+static int worker_init(struct worker *wk, struct shared *sh)
+{
+	memset(wk, 0, sizeof *wk);
+	wk->sh = sh;
+	const int w = sh->img->w, nch = sh->img->nch;
+	const int rows = STRIP_ROWS + 2 * sh->s;
+	wk->npx = (size_t)rows * w;
+	size_t per = wk->npx * (3 * (size_t)nch + 3);
+	wk->store = malloc(per * sh->ncand * sizeof(float));
+	wk->elig = malloc(wk->npx);
+	int rmax = 0;
+	for (int i = 0; i < sh->nr; i++)
+		rmax = sh->filt[i].r > rmax ? sh->filt[i].r : rmax;
+	wk->fscratch = malloc(lpr_fast_scratch(w, nch, rows, rmax) * sizeof(double));
+	wk->hn = malloc(3 * wk->npx * sizeof(float));
+	wk->pad = malloc(3 * ((size_t)w + 2 * LPR_MAXRADIUS) * sizeof(float));
+	wk->cv = malloc((size_t)sh->ncand * STRIP_ROWS * w * sizeof(float));
+	wk->qs = malloc((size_t)sh->ncand * STRIP_ROWS * w * sizeof(float));
+	if (!wk->store || !wk->elig || !wk->fscratch || !wk->hn || !wk->pad || !wk->cv || !wk->qs)
+		return -1;
+	for (int k = 0; k < sh->ncand; k++) {
+		float *b = wk->store + per * k;
+		wk->buf[k].fit = b;
+		wk->buf[k].dx = b + wk->npx * nch;
+		wk->buf[k].dy = b + 2 * wk->npx * nch;
+		wk->buf[k].lev = b + 3 * wk->npx * nch;
+		wk->buf[k].e2 = wk->buf[k].lev + wk->npx;
+		wk->buf[k].q = wk->buf[k].e2 + wk->npx;
+	}
+	return 0;
+}
+
+static void worker_release(struct worker *wk)
+{
+	free(wk->store);
+	free(wk->elig);
+	free(wk->fscratch);
+	free(wk->hn);
+	free(wk->pad);
+	free(wk->cv);
+	free(wk->qs);
+}
+
+static int check_args(const struct lpr_image *img, const struct lpr_image *feat,
+		      const struct lpr_params *p, char *err, size_t errlen)
+{
+	if (!img || !img->px || img->w < 1 || img->h < 1) {
+		seterr(err, errlen, "empty image");
+		return -1;
+	}
+	if (img->nch < 1 || img->nch > LPR_MAXCH) {
+		seterr(err, errlen, "image has %d channels (1 to %d supported)", img->nch, LPR_MAXCH);
+		return -1;
+	}
+	if (feat && (feat->w != img->w || feat->h != img->h)) {
+		seterr(err, errlen, "features are %dx%d but the image is %dx%d",
+		       feat->w, feat->h, img->w, img->h);
+		return -1;
+	}
+	if (feat && (feat->nch < 1 || feat->nch > LPR_MAXFEAT || !feat->px)) {
+		seterr(err, errlen, "features have %d channels (1 to %d supported)",
+		       feat->nch, LPR_MAXFEAT);
+		return -1;
+	}
+	if (p->order < -1 || p->order > 2) {
+		seterr(err, errlen, "order %d is not one of auto, 0, 1, 2", p->order);
+		return -1;
+	}
+	if (p->radius < 0 || p->radius > LPR_MAXRADIUS) {
+		seterr(err, errlen, "radius %d is not in 1..%d", p->radius, LPR_MAXRADIUS);
+		return -1;
+	}
+	if (!p->radius && (p->nradii < 1 || p->nradii > 8)) {
+		seterr(err, errlen, "bad number of candidate radii %d", p->nradii);
+		return -1;
+	}
+	for (int i = 0; !p->radius && i < p->nradii; i++)
+		if (p->radii[i] < 1 || p->radii[i] > LPR_MAXRADIUS) {
+			seterr(err, errlen, "radius %d is not in 1..%d", p->radii[i], LPR_MAXRADIUS);
+			return -1;
+		}
+	if (p->smooth_radius < 1 || p->smooth_radius > LPR_MAXRADIUS) {
+		seterr(err, errlen, "smoothing radius %d is not in 1..%d", p->smooth_radius,
+		       LPR_MAXRADIUS);
+		return -1;
+	}
+	return 0;
+}
+
+static int result_alloc(struct lpr_result *out, int w, int h, int nch)
+{
+	memset(out, 0, sizeof *out);
+	out->w = w;
+	out->h = h;
+	out->nch = nch;
+	size_t n = (size_t)w * h;
+	out->fit = malloc(n * nch * sizeof(float));
+	out->dx = malloc(n * nch * sizeof(float));
+	out->dy = malloc(n * nch * sizeof(float));
+	out->leverage = malloc(n * sizeof(float));
+	out->error = malloc(n * sizeof(float));
+	out->order = malloc(n * sizeof(float));
+	out->bandwidth = malloc(n * sizeof(float));
+	if (!out->fit || !out->dx || !out->dy || !out->leverage || !out->error ||
+	    !out->order || !out->bandwidth) {
+		lpr_result_release(out);
+		return -1;
+	}
+	return 0;
+}
+
+/* The fixed per-image inputs: clean copy, validity, summed-area table. */
+static int prepare(struct shared *sh)
+{
+	const struct lpr_image *img = sh->img;
+	const int w = img->w, h = img->h, nch = img->nch;
+	size_t n = (size_t)w * h;
+	sh->clean = malloc(n * nch * sizeof(float));
+	sh->valid = malloc(n);
+	sh->sat = calloc((size_t)(w + 1) * (h + 1), sizeof(int));
+	if (!sh->clean || !sh->valid || !sh->sat)
+		return -1;
+	for (size_t i = 0; i < n; i++) {
+		int ok = lpr_sample_valid(img, sh->feat, i);
+		sh->valid[i] = (unsigned char)ok;
+		for (int c = 0; c < nch; c++)
+			sh->clean[i * nch + c] = ok ? img->px[i * nch + c] : 0.0f;
+	}
+	size_t W = (size_t)w + 1;
+	for (int y = 0; y < h; y++) {
+		int rowsum = 0;
+		for (int x = 0; x < w; x++) {
+			rowsum += !sh->valid[(size_t)y * w + x];
+			sh->sat[(size_t)(y + 1) * W + x + 1] = sh->sat[(size_t)y * W + x + 1] + rowsum;
+		}
+	}
+	return 0;
+}
+
+int lpr_analyze(const struct lpr_image *img, const struct lpr_image *features,
+		const struct lpr_params *p, struct lpr_result *out,
+		char *err, size_t errlen)
+{
+	struct lpr_params defaults;
+	if (!p) {
+		lpr_params_init(&defaults);
+		p = &defaults;
+	}
+	memset(out, 0, sizeof *out);
+	if (check_args(img, features, p, err, errlen))
+		return -1;
+
+	struct shared *sh = calloc(1, sizeof *sh);
+	if (!sh) {
+		seterr(err, errlen, "out of memory");
+		return -1;
+	}
+	sh->img = img;
+	sh->feat = features;
+	sh->p = p;
+	sh->out = out;
+	sh->s = p->smooth_radius;
+	sh->nr = p->radius ? 1 : p->nradii;
+	for (int i = 0; i < sh->nr; i++)
+		lpr_filters_init(&sh->filt[i], p->radius ? p->radius : p->radii[i]);
+	int omin = p->order < 0 ? 0 : p->order, omax = p->order < 0 ? 2 : p->order;
+	sh->maxorder = omax;
+	memset(sh->candidx, -1, sizeof sh->candidx);
+	/* Preference: lower order first, then the larger radius. */
+	int rorder[8];
+	for (int i = 0; i < sh->nr; i++)
+		rorder[i] = i;
+	for (int i = 1; i < sh->nr; i++)
+		for (int j = i; j > 0 && sh->filt[rorder[j]].r > sh->filt[rorder[j - 1]].r; j--) {
+			int t = rorder[j];
+			rorder[j] = rorder[j - 1];
+			rorder[j - 1] = t;
+		}
+	for (int o = omin; o <= omax; o++)
+		for (int i = 0; i < sh->nr; i++) {
+			sh->candidx[o][rorder[i]] = sh->ncand;
+			sh->cand[sh->ncand++] = (struct cand){ o, rorder[i] };
+		}
+
+	int nth = p->nthreads;
+	if (nth <= 0) {
+		long n = sysconf(_SC_NPROCESSORS_ONLN);
+		nth = n > 0 ? (int)n : 1;
+	}
+	sh->nstrips = (img->h + STRIP_ROWS - 1) / STRIP_ROWS;
+	if (nth > sh->nstrips)
+		nth = sh->nstrips;
+	pthread_mutex_init(&sh->lock, NULL);
+
+	int rc = -1;
+	struct worker *wk = calloc((size_t)nth, sizeof *wk);
+	pthread_t *tid = calloc((size_t)nth, sizeof *tid);
+	if (!wk || !tid || prepare(sh) || result_alloc(out, img->w, img->h, img->nch)) {
+		seterr(err, errlen, "out of memory");
+		goto done;
+	}
+	int started = 0;
+	for (int i = 0; i < nth; i++)
+		if (worker_init(&wk[i], sh)) {
+			seterr(err, errlen, "out of memory");
+			goto join;
+		}
+	for (; started < nth; started++) {
+		int e = pthread_create(&tid[started], NULL, work, &wk[started]);
+		if (e) {
+			seterr(err, errlen, "cannot start a thread: %s", strerror(e));
+			/* Let the threads already started finish the work. */
+			break;
+		}
+	}
+	if (started == 0)
+		work(&wk[0]);
+	rc = 0;
+join:
+	for (int i = 0; i < started; i++)
+		pthread_join(tid[i], NULL);
+	for (int i = 0; i < nth; i++) {
+		out->fast_pixels += wk[i].fast;
+		out->general_pixels += wk[i].general;
+		worker_release(&wk[i]);
+	}
+done:
+	if (rc)
+		lpr_result_release(out);
+	pthread_mutex_destroy(&sh->lock);
+	free(sh->clean);
+	free(sh->valid);
+	free(sh->sat);
+	free(sh);
+	free(wk);
+	free(tid);
+	return rc;
+}
