@@ -23,7 +23,13 @@ TOOL_BIN = $(BUILD)/tests/gen_image $(BUILD)/bench/bench_analyze
 .PHONY: all check unit e2e bench clean deps
 all: $(BUILD)/povpress
 
-$(BUILD)/%.o: %.c
+# The Debian packages are installed (when missing) once per build tree.
+$(BUILD)/.deps: scripts/install-deps.sh
+	@mkdir -p $(BUILD)
+	scripts/install-deps.sh
+	@touch $@
+
+$(BUILD)/%.o: %.c | $(BUILD)/.deps
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -MMD -MP -c $< -o $@
 
@@ -36,12 +42,11 @@ $(BUILD)/tests/test_%: $(BUILD)/tests/test_%.o $(REG_OBJ) $(LIB_DRV_OBJ)
 $(BUILD)/tests/gen_image: $(BUILD)/tests/gen_image.o $(LIB_DRV_OBJ) $(REG_OBJ)
 	$(CC) $(CFLAGS) -o $@ $^ $(EXR_LIBS) $(LDLIBS)
 
-$(BUILD)/bench/bench_analyze: $(BUILD)/scripts/bench_analyze.o $(REG_OBJ)
+$(BUILD)/bench/bench_analyze: $(BUILD)/scripts/bench_analyze.o $(REG_OBJ) | $(BUILD)/.deps
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
 
-deps:
-	scripts/install-deps.sh
+deps: $(BUILD)/.deps
 
 unit: $(UNIT_BIN)
 	@set -e; for t in $(UNIT_BIN); do echo "== $$t"; $$t; done

@@ -166,6 +166,15 @@ int image_channel(const struct image *img, const char *name)
 	return -1;
 }
 
+/*
+ * OpenEXRCore takes the line stride in bytes as an int32_t, which bounds
+ * the width times the channel count of an image we can read or write.
+ */
+static int stride_fits(int64_t w, int64_t nch)
+{
+	return w * nch <= INT32_MAX / (int64_t)sizeof(float);
+}
+
 /* ------------------------------------------------------------------ */
 /* reading */
 
@@ -186,8 +195,8 @@ static int64_t src_read(exr_const_context_t ctxt, void *userdata, void *buffer,
 		return -1;
 	}
 	while (done < sz) {
-		size_t want = sz - done > (uint64_t)(SSIZE_MAX / 2) ?
-			(size_t)(SSIZE_MAX / 2) : (size_t)(sz - done);
+		size_t want = sz - done > (uint64_t)SSIZE_MAX ?
+			(size_t)SSIZE_MAX : (size_t)(sz - done);
 		ssize_t n = pread(src->fd, p + done, want, (off_t)(offset + done));
 
 		if (n < 0) {
@@ -270,6 +279,7 @@ static int read_chunk(struct reader *rd, const exr_chunk_info_t *ci, int x0, int
 	struct image *img = rd->img;
 	exr_result_t rv;
 
+	exr_msg_reset();
 	/* a corrupt file must not make us write outside the image */
 	if (x0 < 0 || y0 < 0 || ci->width <= 0 || ci->height <= 0 ||
 	    ci->width > img->w - x0 || ci->height > img->h - y0) {
@@ -325,6 +335,7 @@ static int read_scanlines(struct reader *rd, const exr_attr_box2i_t *dw)
 	}
 	/* int64_t: a data window ending at INT_MAX must not overflow y */
 	for (int64_t y = dw->min.y; y <= dw->max.y; y += lpc) {
+		exr_msg_reset();
 		rv = exr_read_scanline_chunk_info(rd->ctx, 0, (int)y, &ci);
 		if (rv != EXR_ERR_SUCCESS) {
 			set_pixel_err(rd->err, rd->errlen, rd->path, rv);
@@ -355,6 +366,7 @@ static int read_tiles(struct reader *rd)
 	}
 	for (int ty = 0; ty <= (lh - 1) / th; ty++) {
 		for (int tx = 0; tx <= (lw - 1) / tw; tx++) {
+			exr_msg_reset();
 			rv = exr_read_tile_chunk_info(rd->ctx, 0, tx, ty, 0, 0, &ci);
 			if (rv != EXR_ERR_SUCCESS) {
 				set_pixel_err(rd->err, rd->errlen, rd->path, rv);
@@ -422,6 +434,11 @@ static int read_part0(struct reader *rd)
 			rd->path);
 		return -1;
 	}
+	if (!stride_fits(w, chl->num_channels)) {
+		set_err(rd->err, rd->errlen, "cannot read '%s': %lld pixels x %d channels "
+			"per line is too many", rd->path, (long long)w, chl->num_channels);
+		return -1;
+	}
 	names = calloc((size_t)chl->num_channels, sizeof(*names));
 	if (!names) {
 		set_err(rd->err, rd->errlen, "cannot read '%s': out of memory", rd->path);
@@ -437,6 +454,15 @@ static int read_part0(struct reader *rd)
 			goto out;
 		}
 		names[c] = e->name.str;
+		/* channels are matched by name, so a damaged list must not repeat one */
+		for (int k = 0; k < c; k++) {
+			if (!strcmp(names[k], names[c])) {
+				set_err(rd->err, rd->errlen,
+					"cannot read '%s': channel '%s' appears twice",
+					rd->path, names[c]);
+				goto out;
+			}
+		}
 	}
 	if (image_init(rd->img, (int)w, (int)h, chl->num_channels, names, rd->err, rd->errlen)) {
 		char why[200];
@@ -542,14 +568,18 @@ static int64_t dst_write(exr_const_context_t ctxt, void *userdata, const void *b
 		return -1;
 	}
 	while (done < sz) {
-		size_t want = sz - done > (uint64_t)(SSIZE_MAX / 2) ?
-			(size_t)(SSIZE_MAX / 2) : (size_t)(sz - done);
+		size_t want = sz - done > (uint64_t)SSIZE_MAX ?
+			(size_t)SSIZE_MAX : (size_t)(sz - done);
 		ssize_t n = pwrite(dst->fd, p + done, want, (off_t)(offset + done));
 
 		if (n < 0) {
 			if (errno == EINTR)
 				continue;
 			error_cb(ctxt, EXR_ERR_WRITE_IO, "%s", strerror(errno));
+			return -1;
+		}
+		if (n == 0) {
+			error_cb(ctxt, EXR_ERR_WRITE_IO, "%s", strerror(EIO));
 			return -1;
 		}
 		done += (uint64_t)n;
@@ -651,10 +681,15 @@ static int write_fd(int fd, const char *path, const struct image *img, exr_pixel
 	if (rv == EXR_ERR_SUCCESS)
 		rv = exr_initialize_required_attr_simple(ctx, part, img->w, img->h,
 							 EXR_COMPRESSION_ZIP);
-	/* the library keeps channels sorted by name; data is matched by name */
+	/*
+	 * The library keeps channels sorted by name, so the encoder's channel
+	 * order need not be img's; aim_encoder() matches them by name.  The
+	 * perceptual flag only steers lossy codecs; "logarithmic" is what
+	 * OpenEXR's C++ library writes by default.
+	 */
 	for (int c = 0; rv == EXR_ERR_SUCCESS && c < img->nch; c++)
 		rv = exr_add_channel(ctx, part, img->names[c], type,
-				     EXR_PERCEPTUALLY_LINEAR, 1, 1);
+				     EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1);
 	if (rv == EXR_ERR_SUCCESS)
 		rv = encode_image(ctx, img);
 	/* exr_finish writes the chunk offset table, so it can fail too */
@@ -672,9 +707,9 @@ static int write_fd(int fd, const char *path, const struct image *img, exr_pixel
 static mode_t current_umask(void)
 {
 	/*
-	 * POSIX can only read the umask by setting it.  Another thread
-	 * creating a file between these two calls would get mode 0 masking;
-	 * povpress writes its images from the main thread.
+	 * POSIX can only read the umask by setting it.  A file that another
+	 * thread creates between these two calls gets umask 022 instead of
+	 * the real one; povpress creates files from its main thread only.
 	 */
 	mode_t mask = umask(022);
 
@@ -692,6 +727,11 @@ static int write_exr(const char *path, const struct image *img, exr_pixel_type_t
 
 	if (!img || !img->px || !img->names || img->w <= 0 || img->h <= 0 || img->nch <= 0) {
 		set_err(err, errlen, "cannot write '%s': empty image", path);
+		return -1;
+	}
+	if (!stride_fits(img->w, img->nch)) {
+		set_err(err, errlen, "cannot write '%s': %d pixels x %d channels per line "
+			"is too many", path, img->w, img->nch);
 		return -1;
 	}
 	len = strlen(path);
@@ -767,7 +807,7 @@ int image_rgb(const struct image *src, const char *what, struct image *out,
 		int y = image_channel(src, "Y");
 
 		if (y < 0) {
-			set_err(err, errlen, "'%s' has no colour channels (R, G, B or Y)", what);
+			set_err(err, errlen, "'%s' has no colour channels (needs R, G and B, or Y)", what);
 			return -1;
 		}
 		idx[0] = idx[1] = idx[2] = y;

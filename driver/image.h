@@ -34,16 +34,21 @@ int image_channel(const struct image *img, const char *name);
 /*
  * Read every channel of the first part of an EXR file (scanline or tiled,
  * half, float or uint) as float.  The data window becomes the image; channels
- * keep the file's names in the file's (alphabetical) order.  On failure
- * returns -1 with a message such as "cannot read 'a.exr': not an EXR file"
- * and leaves *out zeroed.  You own *out; free it with image_release().
+ * keep the file's names in the file's (alphabetical) order.  Of a mipmapped
+ * or ripmapped file, the full-resolution level is read.  Deep images,
+ * subsampled channels and, with OpenEXR before 3.2, DWAA/DWAB compression
+ * are refused.  On failure returns -1 with a message such as
+ * "cannot read 'a.exr': not an EXR file" and leaves *out zeroed.  You own
+ * *out; free it with image_release().
  */
 int image_read_exr(const char *path, struct image *out, char *err, size_t errlen);
 
 /*
  * Write img as a single-part scanline EXR, 32-bit float, ZIP compression,
- * channels in img's order with img's names.  The data is written to a
- * temporary file in the same directory and renamed over path only when
+ * one channel per img channel with img's names (OpenEXR stores channels
+ * sorted by name, so image_read_exr() returns them in that order).  Names
+ * must be distinct and non-empty.  The data is written to a temporary file
+ * PATH.tmp.XXXXXX in the same directory and renamed over path only when
  * complete, so a failure never leaves a partial file at path.
  */
 int image_write_exr(const char *path, const struct image *img, char *err, size_t errlen);

@@ -20,7 +20,9 @@
 #include <math.h>
 #include <string.h>
 
-#define BLK 8
+#define BLK 8   /* horizontal pass: outputs summed in registers */
+#define VBLK 4  /* vertical pass: five sums each */
+#define TILE 64 /* vertical pass: pixels per column tile */
 
 /* The convolutions are most of the analysis time: on x86-64 build them
  * also for AVX2 with FMA and let the loader pick what the CPU runs. */
@@ -159,36 +161,32 @@ long lpr_fast_strip(const struct lpr_filters *f, const float *clean, int w, int 
 		}
 	}
 
+	/* Vertical passes, a tile of TILE pixels at a time for every row, so
+	 * that the 2r + 1 rows a tile reads stay in cache from row to row. */
 	const double s2 = f->s * f->s;
 	const double d0 = 1.0 - f->h0, d2 = 1.0 - f->h2;
 	long n = 0;
-	for (int y = va; y < vb; y++) {
-		const unsigned char *el = elig + (size_t)(y - ya) * w;
-		int any = 0;
-		for (int x = r; x < w - r && !any; x++)
-			any = el[x] == 1;
-		if (!any)
-			continue;
-		double *a00 = acc, *a20 = acc + rowlen, *a02 = acc + 2 * rowlen;
-		double *ax = acc + 3 * rowlen, *ay = acc + 4 * rowlen;
-		for (size_t k0 = xa; k0 < xb; k0 += BLK) {
-			int nb = xb - k0 < BLK ? (int)(xb - k0) : BLK;
-			double s00[BLK] = {0}, s20[BLK] = {0}, s02[BLK] = {0};
-			double sx[BLK] = {0}, sy[BLK] = {0};
-			for (int j = -r; j <= r; j++) {
-				const size_t off = (size_t)(y + j - ha) * rowlen + k0;
-				const double *rw = hw + off, *ru = hu + off, *ru2 = hu2 + off;
-				double t = f->t[j + r], tv = f->tu[j + r], tv2 = f->tu2[j + r];
-				if (nb == BLK) {
-					for (int m = 0; m < BLK; m++) {
-						s00[m] += t * rw[m];
-						s20[m] += t * ru2[m];
-						s02[m] += tv2 * rw[m];
-						sx[m] += t * ru[m];
-						sy[m] += tv * rw[m];
-					}
-				} else {
-					for (int m = 0; m < nb; m++) {
+	for (int tx = r; tx < w - r; tx += TILE) {
+		const int tx1 = tx + TILE < w - r ? tx + TILE : w - r;
+		const size_t ka = (size_t)tx * nch, kb = (size_t)tx1 * nch;
+		for (int y = va; y < vb; y++) {
+			const unsigned char *el = elig + (size_t)(y - ya) * w;
+			int any = 0;
+			for (int x = tx; x < tx1 && !any; x++)
+				any = el[x] == 1;
+			if (!any)
+				continue;
+			double *a00 = acc, *a20 = acc + rowlen, *a02 = acc + 2 * rowlen;
+			double *ax = acc + 3 * rowlen, *ay = acc + 4 * rowlen;
+			for (size_t k0 = ka; k0 < kb; k0 += VBLK) {
+				int nb = kb - k0 < VBLK ? (int)(kb - k0) : VBLK;
+				double s00[VBLK] = {0}, s20[VBLK] = {0}, s02[VBLK] = {0};
+				double sx[VBLK] = {0}, sy[VBLK] = {0};
+				for (int j = -r; j <= r; j++) {
+					const size_t off = (size_t)(y + j - ha) * rowlen + k0;
+					const double *rw = hw + off, *ru = hu + off, *ru2 = hu2 + off;
+					double t = f->t[j + r], tv = f->tu[j + r], tv2 = f->tu2[j + r];
+					for (int m = 0; m < (nb == VBLK ? VBLK : nb); m++) {
 						s00[m] += t * rw[m];
 						s20[m] += t * ru2[m];
 						s02[m] += tv2 * rw[m];
@@ -196,38 +194,38 @@ long lpr_fast_strip(const struct lpr_filters *f, const float *clean, int w, int 
 						sy[m] += tv * rw[m];
 					}
 				}
+				size_t nbytes = (size_t)nb * sizeof(double);
+				memcpy(a00 + k0, s00, nbytes);
+				memcpy(a20 + k0, s20, nbytes);
+				memcpy(a02 + k0, s02, nbytes);
+				memcpy(ax + k0, sx, nbytes);
+				memcpy(ay + k0, sy, nbytes);
 			}
-			size_t nbytes = (size_t)nb * sizeof(double);
-			memcpy(a00 + k0, s00, nbytes);
-			memcpy(a20 + k0, s20, nbytes);
-			memcpy(a02 + k0, s02, nbytes);
-			memcpy(ax + k0, sx, nbytes);
-			memcpy(ay + k0, sy, nbytes);
-		}
-		size_t base = (size_t)(y - ya) * w;
-		const float *in = clean + (size_t)y * rowlen;
-		for (int x = r; x < w - r; x++) {
-			if (el[x] != 1)
-				continue;
-			double fit0[LPR_MAXCH], fit2[LPR_MAXCH], dx[LPR_MAXCH], dy[LPR_MAXCH];
-			double p0 = 0.0, p2 = 0.0;
-			for (int ch = 0; ch < nch; ch++) {
-				size_t k = (size_t)x * nch + ch;
-				double yv = in[k];
-				fit0[ch] = a00[k] / s2;
-				fit2[ch] = f->c0 * a00[k] + f->c3 * a20[k] + f->c5 * a02[k];
-				dx[ch] = f->gscale * ax[k];
-				dy[ch] = f->gscale * ay[k];
-				double e0 = (yv - fit0[ch]) / d0, e2 = (yv - fit2[ch]) / d2;
-				p0 += e0 * e0;
-				p2 += e2 * e2;
+			size_t base = (size_t)(y - ya) * w;
+			const float *in = clean + (size_t)y * rowlen;
+			for (int x = tx; x < tx1; x++) {
+				if (el[x] != 1)
+					continue;
+				double fit0[LPR_MAXCH], fit2[LPR_MAXCH], dx[LPR_MAXCH], dy[LPR_MAXCH];
+				double p0 = 0.0, p2 = 0.0;
+				for (int ch = 0; ch < nch; ch++) {
+					size_t k = (size_t)x * nch + ch;
+					double yv = in[k];
+					fit0[ch] = a00[k] / s2;
+					fit2[ch] = f->c0 * a00[k] + f->c3 * a20[k] + f->c5 * a02[k];
+					dx[ch] = f->gscale * ax[k];
+					dy[ch] = f->gscale * ay[k];
+					double e0 = (yv - fit0[ch]) / d0, e2 = (yv - fit2[ch]) / d2;
+					p0 += e0 * e0;
+					p2 += e2 * e2;
+				}
+				p0 /= nch;
+				p2 /= nch;
+				put(c[0], base + x, nch, fit0, dx, dy, f->h0, p0, p0 / (1.0 + f->v0));
+				put(c[1], base + x, nch, fit0, dx, dy, f->h0, p0, p0 / (1.0 + f->v0));
+				put(c[2], base + x, nch, fit2, dx, dy, f->h2, p2, p2 / (1.0 + f->v2));
+				n++;
 			}
-			p0 /= nch;
-			p2 /= nch;
-			put(c[0], base + x, nch, fit0, dx, dy, f->h0, p0, p0 / (1.0 + f->v0));
-			put(c[1], base + x, nch, fit0, dx, dy, f->h0, p0, p0 / (1.0 + f->v0));
-			put(c[2], base + x, nch, fit2, dx, dy, f->h2, p2, p2 / (1.0 + f->v2));
-			n++;
 		}
 	}
 	return n;

@@ -170,6 +170,27 @@ static void fit_rows(struct worker *wk, int ya, int yb)
  * s, leaving out entries that are not finite; rows [y0, y1) of the output,
  * from the fitted rows [ya, yb).
  */
+/* o[x] = sum_i t[i] in[x + i] for i in [0, n): in is padded. */
+static void conv_row(float *restrict o, const float *restrict in, int w,
+		     const float *restrict t, int n)
+{
+	for (int x = 0; x < w; x++)
+		o[x] = 0.0f;
+	for (int i = 0; i < n; i++) {
+		const float ti = t[i];
+		const float *restrict src = in + i;
+		for (int x = 0; x < w; x++)
+			o[x] += ti * src[x];
+	}
+}
+
+/* acc[x] += t in[x] */
+static void axpy_row(float *restrict acc, const float *restrict in, float t, int w)
+{
+	for (int x = 0; x < w; x++)
+		acc[x] += t * in[x];
+}
+
 static void smooth(struct worker *wk, const struct lpr_cand_buf *b, int ya, int yb,
 		   int y0, int y1, float *cv, float *qs)
 {
@@ -195,17 +216,9 @@ static void smooth(struct worker *wk, const struct lpr_cand_buf *b, int ya, int 
 			pq[x + s] = ok ? b->q[row + x] : 0.0f;
 			pm[x + s] = ok ? 1.0f : 0.0f;
 		}
-		float *he = hn + row, *hq = hn + plane + row, *hm = hn + 2 * plane + row;
-		for (int x = 0; x < w; x++)
-			he[x] = hq[x] = hm[x] = 0.0f;
-		for (int i = 0; i <= 2 * s; i++) {
-			float ti = t[i];
-			for (int x = 0; x < w; x++) {
-				he[x] += ti * pe[x + i];
-				hq[x] += ti * pq[x + i];
-				hm[x] += ti * pm[x + i];
-			}
-		}
+		conv_row(hn + row, pe, w, t, 2 * s + 1);
+		conv_row(hn + plane + row, pq, w, t, 2 * s + 1);
+		conv_row(hn + 2 * plane + row, pm, w, t, 2 * s + 1);
 	}
 	float *ae = wk->pad, *aq = ae + w, *am = aq + w;
 	for (int y = y0; y < y1; y++) {
@@ -215,12 +228,9 @@ static void smooth(struct worker *wk, const struct lpr_cand_buf *b, int ya, int 
 		for (int j = j0; j <= j1; j++) {
 			size_t k = (size_t)(y + j - ya) * w;
 			float tj = t[j + s];
-			const float *he = hn + k, *hq = hn + plane + k, *hm = hn + 2 * plane + k;
-			for (int x = 0; x < w; x++) {
-				ae[x] += tj * he[x];
-				aq[x] += tj * hq[x];
-				am[x] += tj * hm[x];
-			}
+			axpy_row(ae, hn + k, tj, w);
+			axpy_row(aq, hn + plane + k, tj, w);
+			axpy_row(am, hn + 2 * plane + k, tj, w);
 		}
 		size_t o = (size_t)(y - y0) * w;
 		for (int x = 0; x < w; x++) {

@@ -638,7 +638,10 @@ static void test_not_exr(void **state)
 	assert_zeroed(&got);
 }
 
-/* Write a file, cut it to `keep` bytes (or half when keep is 0), expect failure. */
+/*
+ * Write a file, cut it to `keep` bytes (half when keep is 0, all but -keep
+ * bytes when keep is negative), expect failure.
+ */
 static void check_truncated(const char *name, const char *tool_args, off_t keep)
 {
 	struct image img, got;
@@ -658,7 +661,8 @@ static void check_truncated(const char *name, const char *tool_args, off_t keep)
 	image_release(&got);
 
 	assert_int_equal(stat(path, &st), 0);
-	assert_int_equal(truncate(path, keep ? keep : st.st_size / 2), 0);
+	assert_int_equal(truncate(path, keep > 0 ? keep : keep < 0 ? st.st_size + keep :
+				  st.st_size / 2), 0);
 	err[0] = '\0';
 	assert_int_equal(image_read_exr(path, &got, err, sizeof(err)), -1);
 	assert_err_names(err, path);
@@ -677,6 +681,8 @@ static void test_truncated_uncompressed(void **state)
 	(void)state;
 	/* uncompressed chunks are read with short reads allowed */
 	check_truncated("trunc_none.exr", "--compression none", 0);
+	/* only the end of the last chunk missing: must not come back zero-filled */
+	check_truncated("trunc_none_tail.exr", "--compression none", -10);
 }
 
 static void test_truncated_tiled(void **state)

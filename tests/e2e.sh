@@ -1,0 +1,212 @@
+#!/usr/bin/env bash
+# End-to-end tests of the povpress binary: analyze and compare on synthetic
+# EXR images made by tests/gen_image, on bad input, and on a POV-Ray render
+# of a bundled scene.  Images are checked with OpenImageIO's tools.
+#
+# usage: tests/e2e.sh BUILD_DIR
+set -u
+
+BUILD=${1:-build}
+PP="$BUILD/povpress"
+GEN="$BUILD/tests/gen_image"
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+T=$(mktemp -d "${TMPDIR:-/tmp}/povpress-e2e.XXXXXX")
+trap 'rm -rf "$T"' EXIT
+
+passed=0
+failed=0
+ok() { passed=$((passed + 1)); echo "ok   - $1"; }
+bad() { failed=$((failed + 1)); echo "FAIL - $1"; }
+check() { # check DESCRIPTION COMMAND...
+	local d=$1
+	shift
+	if "$@"; then ok "$d"; else bad "$d"; fi
+}
+
+# stat IMAGE CHANNEL FIELD: one field (Min, Max, Avg, NanCount, InfCount)
+# of `oiiotool --printstats` for one channel.
+chstat() {
+	oiiotool "$1" --ch "$2" --printstats 2>/dev/null |
+		awk -v f="$3" '$1 == "Stats" && $2 == f":" { print $3 }'
+}
+# cutstat IMAGE GEOMETRY CHANNEL FIELD: the same over a region WxH+X+Y.
+cutstat() {
+	oiiotool "$1" --ch "$3" --cut "$2" --printstats 2>/dev/null |
+		awk -v f="$4" '$1 == "Stats" && $2 == f":" { print $3 }'
+}
+# fraction of pixels whose order is at least N (1 or 2), over a region.
+order_frac() { # IMAGE GEOMETRY N
+	oiiotool "$1" --ch order --cut "$2" --subc $(($3 - 1)) --clamp:min=0:max=1 \
+		--printstats 2>/dev/null | awk '$1 == "Stats" && $2 == "Avg:" { print $3 }'
+}
+# true when awk says so: num 'EXPR' with a=$2 b=$3 ...
+num() {
+	awk -v a="${2:-0}" -v b="${3:-0}" -v c="${4:-0}" "BEGIN { exit !($1) }"
+}
+cmpval() { # cmpval OUTPUT KEY: value printed by compare
+	awk -v k="$2:" '$1 == k { print $2 }' <<<"$1"
+}
+
+echo "# povpress end-to-end tests in $T"
+
+# --- the command line ------------------------------------------------------
+check "povpress --help exits 0" "$PP" --help >/dev/null
+check "analyze --help exits 0" "$PP" analyze --help >/dev/null
+check "compare --help exits 0" "$PP" compare --help >/dev/null
+"$PP" analyze --order 7 x.exr -o y.exr 2>/dev/null
+check "bad --order is a usage error (2)" test $? -eq 2
+"$PP" frobnicate 2>/dev/null
+check "unknown command is a usage error (2)" test $? -eq 2
+
+# --- exact quadratic -------------------------------------------------------
+"$GEN" quadratic 128 96 "$T/quad.exr"
+"$PP" analyze "$T/quad.exr" -o "$T/quad.a.exr"
+check "quadratic: analyze succeeds" test -s "$T/quad.a.exr"
+oiiotool "$T/quad.a.exr" --ch R,G,B -o "$T/quad.rgb.exr"
+check "quadratic: reproduced to 1e-5 relative" \
+	idiff -q -fail 4e-6 -failpercent 0 "$T/quad.exr" "$T/quad.rgb.exr"
+check "quadratic: error ~ 0" num 'a < 1e-9' "$(chstat "$T/quad.a.exr" error Max)"
+f=$(order_frac "$T/quad.a.exr" 112x80+8+8 2)
+check "quadratic: order 2 on >= 90% of interior pixels ($f)" num 'a >= 0.9' "$f"
+chans=$(iinfo -v "$T/quad.a.exr" | awk -F': ' '/channel list/ { print $2 }')
+for c in R G B error order bandwidth dx.R dx.G dx.B dy.R dy.G dy.B; do
+	case ", $chans," in
+	*", $c,"*) ;;
+	*) bad "output channel $c missing ($chans)"; continue ;;
+	esac
+done
+check "analysis is a float EXR" sh -c "iinfo '$T/quad.a.exr' | grep -q 'float openexr'"
+
+# --- noise -----------------------------------------------------------------
+"$GEN" noise 128 128 "$T/noise.exr" 3
+"$PP" analyze "$T/noise.exr" -o "$T/noise.a.exr"
+e=$(chstat "$T/noise.a.exr" error Avg)
+check "noise: mean error within 25% of sigma^2 ($e vs 0.0025)" num 'a >= 0.001875 && a <= 0.003125' "$e"
+f=$(order_frac "$T/noise.a.exr" 128x128+0+0 1)
+check "noise: order 0 on >= 70% of pixels (order>0 on $f)" num 'a <= 0.3' "$f"
+oiiotool --pattern constant:color=0.5,0.5,0.5 128x128 3 -d float -o "$T/half.exr"
+out=$("$PP" compare "$T/noise.a.exr" "$T/half.exr")
+m=$(cmpval "$out" mse)
+check "noise: reconstruction MSE <= sigma^2/4 ($m)" num 'a <= 0.000625' "$m"
+check "compare prints relmse, mse, psnr" sh -c "printf '%s\n' \"$out\" | awk '\$1==\"relmse:\"{a=1} \$1==\"mse:\"{b=1} \$1==\"psnr:\"{c=1} END{exit !(a&&b&&c)}'"
+
+# --- scale invariance --------------------------------------------------------
+oiiotool "$T/noise.exr" --mulc 1e4 -d float -o "$T/noise4.exr"
+"$PP" analyze "$T/noise4.exr" -o "$T/noise4.a.exr"
+oiiotool "$T/noise.a.exr" --ch order,bandwidth -o "$T/ob1.exr"
+oiiotool "$T/noise4.a.exr" --ch order,bandwidth -o "$T/ob2.exr"
+check "x1e4: no order or bandwidth changes" idiff -q -fail 0 -failpercent 0 "$T/ob1.exr" "$T/ob2.exr"
+e4=$(chstat "$T/noise4.a.exr" error Avg)
+check "x1e4: error multiplied by 1e8 ($e4 vs $e)" num 'b > 0 && a / b > 0.99e8 && a / b < 1.01e8' "$e4" "$e"
+
+# --- ramp gradients ----------------------------------------------------------
+"$GEN" ramp 96 64 "$T/ramp.exr"
+"$PP" analyze "$T/ramp.exr" -o "$T/ramp.a.exr"
+for s in "dx.R 0.001" "dx.G 0.002" "dx.B 0.003" "dy.R 0.002" "dy.G 0.002" "dy.B 0.002"; do
+	set -- $s
+	lo=$(cutstat "$T/ramp.a.exr" 80x48+8+8 "$1" Min)
+	hi=$(cutstat "$T/ramp.a.exr" 80x48+8+8 "$1" Max)
+	check "ramp: $1 = $2 to 1e-5 in the interior ($lo .. $hi)" \
+		num 'a >= c - 1e-5 && b <= c + 1e-5' "$lo" "$hi" "$2"
+done
+
+# --- holes -------------------------------------------------------------------
+"$GEN" holes 96 96 "$T/holes.exr" 5
+"$PP" analyze "$T/holes.exr" -o "$T/holes.a.exr"
+nan=$(oiiotool "$T/holes.a.exr" --printstats 2>/dev/null | awk '$2 == "NanCount:" || $2 == "InfCount:" { for (i = 3; i <= NF; i++) s += $i } END { print s + 0 }')
+check "holes: no NaN or Inf in any output channel ($nan)" test "$nan" -eq 0
+oiiotool "$T/holes.a.exr" --ch R,G,B -o "$T/holes.rgb.exr"
+"$GEN" quadratic 96 96 "$T/quad96.exr"
+check "holes: filled to 1e-3 relative" idiff -q -fail 4e-4 -failpercent 0 "$T/quad96.exr" "$T/holes.rgb.exr"
+
+# --- step edge ---------------------------------------------------------------
+"$GEN" step 64 48 "$T/step.exr"
+"$PP" analyze "$T/step.exr" -o "$T/step.a.exr"
+near=$(cutstat "$T/step.a.exr" 4x48+30+0 error Avg)
+far1=$(cutstat "$T/step.a.exr" 12x48+0+0 error Avg)
+far2=$(cutstat "$T/step.a.exr" 12x48+52+0 error Avg)
+check "step: error near the edge >= 10x the error far from it ($near vs $far1, $far2)" \
+	num 'a > 0 && a >= 10 * b && a >= 10 * c' "$near" "$far1" "$far2"
+
+# --- texture and features ------------------------------------------------------
+"$GEN" texture 128 128 "$T/tex.exr" 7
+"$GEN" texture-feature 128 128 "$T/texf.exr"
+"$GEN" texture-clean 128 128 "$T/texc.exr"
+"$PP" analyze "$T/tex.exr" --features "$T/texf.exr" -o "$T/tex.f.exr"
+"$PP" analyze "$T/tex.exr" -o "$T/tex.n.exr"
+ef=$(chstat "$T/tex.f.exr" error Avg)
+en=$(chstat "$T/tex.n.exr" error Avg)
+m=$(cmpval "$("$PP" compare "$T/tex.f.exr" "$T/texc.exr")" mse)
+check "texture+features: mean error within 50% of sigma^2 ($ef vs 0.0004)" num 'a >= 0.0002 && a <= 0.0006' "$ef"
+check "texture+features: reconstruction MSE <= sigma^2/2 ($m)" num 'a <= 0.0002' "$m"
+check "texture without features: error >= 5x higher ($en vs $ef)" num 'a >= 5 * b' "$en" "$ef"
+
+# --- threads -----------------------------------------------------------------
+"$PP" analyze "$T/holes.exr" --threads 1 -o "$T/t1.exr"
+"$PP" analyze "$T/holes.exr" --threads 2 -o "$T/t2.exr"
+check "--threads 1 and 2: bit-identical files" cmp -s "$T/t1.exr" "$T/t2.exr"
+
+# --- input formats -----------------------------------------------------------------
+"$GEN" quadratic-half 64 48 "$T/qh.exr"
+check "half-float input" "$PP" analyze "$T/qh.exr" -o "$T/qh.a.exr"
+oiiotool "$T/quad.exr" --tile 32 32 -o "$T/tiled.exr"
+check "tiled input" "$PP" analyze "$T/tiled.exr" -o "$T/tiled.a.exr"
+oiiotool "$T/tiled.a.exr" --ch R,G,B -o "$T/tiled.rgb.exr"
+check "tiled input gives the scanline result" idiff -q -fail 0 -failpercent 0 "$T/quad.rgb.exr" "$T/tiled.rgb.exr"
+"$GEN" rgba 64 48 "$T/rgba.exr"
+check "RGBA input" "$PP" analyze "$T/rgba.exr" -o "$T/rgba.a.exr"
+
+# --- bad input -----------------------------------------------------------------
+bad_input() { # DESCRIPTION INPUT
+	local d=$1 in=$2 msg rc
+	rm -f "$T/out.exr"
+	msg=$("$PP" analyze "$in" -o "$T/out.exr" 2>&1)
+	rc=$?
+	check "$d: non-zero exit" test $rc -ne 0
+	check "$d: message names the file" grep -qF -- "$in" <<<"$msg"
+	check "$d: no output file" test ! -e "$T/out.exr"
+	check "$d: no temporary file left" sh -c "! ls '$T' | grep -q 'out.exr.'"
+}
+bad_input "missing file" "$T/does-not-exist.exr"
+echo "this is not an image" >"$T/text.exr"
+bad_input "not an EXR" "$T/text.exr"
+head -c $(($(stat -c %s "$T/quad.exr") / 2)) "$T/quad.exr" >"$T/trunc.exr"
+bad_input "truncated EXR" "$T/trunc.exr"
+"$GEN" nocolour 32 32 "$T/nocol.exr"
+bad_input "no colour channels" "$T/nocol.exr"
+msg=$("$PP" analyze "$T/quad.exr" --features "$T/noise.exr" -o "$T/out.exr" 2>&1)
+check "features of another size: error naming the features file" \
+	sh -c "test ! -e '$T/out.exr' && printf '%s' \"\$1\" | grep -qF '$T/noise.exr'" _ "$msg"
+msg=$("$PP" analyze "$T/quad.exr" -o "$T/no/such/dir/out.exr" 2>&1)
+check "unwritable output: error naming it" grep -qF "$T/no/such/dir/out.exr" <<<"$msg"
+
+msg=$("$PP" compare "$T/quad.exr" "$T/noise.exr" 2>&1)
+rc=$?
+check "compare: size mismatch is an error naming the file" \
+	sh -c "test $rc -ne 0 && printf '%s' \"\$1\" | grep -qF '$T/noise.exr'" _ "$msg"
+msg=$("$PP" compare "$T/quad.exr" "$T/nope.exr" 2>&1)
+rc=$?
+check "compare: unreadable file is an error naming it" \
+	sh -c "test $rc -ne 0 && printf '%s' \"\$1\" | grep -qF '$T/nope.exr'" _ "$msg"
+out=$("$PP" compare "$T/quad.exr" "$T/quad.exr")
+check "compare: an image against itself has relmse 0" num 'a == 0' "$(cmpval "$out" relmse)"
+
+# --- a POV-Ray render of a bundled scene ---------------------------------------------
+cp "$ROOT/scenes/soft_shadows.pov" "$T/scene.pov"
+povray -D -GA +W96 +H72 +FE +WT1 "+O$T/render.exr" "+I$T/scene.pov" "+L$ROOT/scenes" \
+	>"$T/povray.log" 2>&1
+check "povray renders scenes/soft_shadows.pov" test -s "$T/render.exr"
+"$PP" analyze "$T/render.exr" -o "$T/render.a.exr"
+check "render: analyze succeeds" test -s "$T/render.a.exr"
+nan=$(oiiotool "$T/render.a.exr" --printstats 2>/dev/null | awk '$2 == "NanCount:" || $2 == "InfCount:" { for (i = 3; i <= NF; i++) s += $i } END { print s + 0 }')
+check "render: every output is finite" test "$nan" -eq 0
+e=$(chstat "$T/render.a.exr" error Avg)
+check "render: the penumbra noise shows as error ($e)" num 'a > 1e-6' "$e"
+povray -D -GA +W96 +H72 +FE +WT1 Declare=AreaN=12 "+O$T/ref.exr" "+I$T/scene.pov" \
+	>"$T/povray-ref.log" 2>&1
+out=$("$PP" compare "$T/render.exr" "$T/ref.exr")
+check "render: compare against a 12x12-light render" num 'a > 0' "$(cmpval "$out" relmse)"
+
+echo
+echo "$passed passed, $failed failed"
+test "$failed" -eq 0
