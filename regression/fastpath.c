@@ -222,7 +222,15 @@ long lpr_fast_strip(const struct lpr_filters *f, const float *clean, int w, int 
 				p0 /= nch;
 				p2 /= nch;
 				put(c[0], base + x, nch, fit0, dx, dy, f->h0, p0, p0 / (1.0 + f->v0));
-				put(c[1], base + x, nch, fit0, dx, dy, f->h0, p0, p0 / (1.0 + f->v0));
+				if (c[1]) {
+					/* Order 1 is order 0 here (u, v are orthogonal to 1
+					 * in a full symmetric window): store its criterion and
+					 * mark the fit NaN to say "same as order 0". */
+					c[1]->fit[(base + x) * nch] = NAN;
+					c[1]->lev[base + x] = (float)f->h0;
+					c[1]->e2[base + x] = (float)p0;
+					c[1]->q[base + x] = (float)(p0 / (1.0 + f->v0));
+				}
 				put(c[2], base + x, nch, fit2, dx, dy, f->h2, p2, p2 / (1.0 + f->v2));
 				n++;
 			}

@@ -57,6 +57,8 @@ size_t lpr_fast_scratch(int w, int nch, int nrows, int r);
  * Fit every pixel of rows [ya, yb) whose elig flag is 1 (elig is indexed
  * from row ya), from clean (the image with holes replaced by 0), writing
  * the order-0, -1 and -2 candidates into c[0..2] (an entry may be NULL).
+ * The order-1 fit equals the order-0 fit on these pixels: only its e2, q
+ * and lev are written, and its first fit value is set to NaN to say so.
  * Buffers are indexed from row ya.  Returns the number of pixels fitted.
  */
 long lpr_fast_strip(const struct lpr_filters *f, const float *clean, int w, int h,

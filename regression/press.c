@@ -4,12 +4,19 @@
  * The image is cut into strips of STRIP_ROWS rows; threads take strips in
  * turn, each with its own scratch, and every strip is computed the same way
  * whichever thread takes it, so the output does not depend on the number of
- * threads.  For a strip, every candidate (order, radius) is fitted on the
- * strip's rows plus a margin of smooth_radius rows, on the fast path where
- * the window is interior and unmasked and on the general path elsewhere.
- * The PRESS terms e^2 of each candidate are then averaged over a tricube
- * neighbourhood (holes and unfittable pixels left out), and each pixel takes
- * the candidate with the smallest average.
+ * threads.  For a strip, one radius at a time, the candidates of every
+ * order are fitted on the strip's rows plus a margin of smooth_radius rows,
+ * on the fast path where the window is interior and unmasked and on the
+ * general path elsewhere.  The PRESS terms e^2 of each candidate are then
+ * averaged over a tricube neighbourhood (holes and unfittable pixels left
+ * out): that average is the candidate's criterion CV.  Each pixel keeps the
+ * candidate with the smallest score
+ *     CV * (1 + tie_tol * order) + 1e-12 * mean(Y^2) * order,
+ * ties going to the lower order and then to the larger radius: a higher
+ * order has to win by a margin, and differences below float resolution of
+ * the pixel's own values count as ties.  The score does not depend on the
+ * order in which candidates are visited, so they are visited radius by
+ * radius and only the best so far is kept.
  */
 #include "regression/lpr_internal.h"
 #include "regression/kernel.h"
@@ -24,41 +31,38 @@
 #include <unistd.h>
 
 #define STRIP_ROWS 64
-#define MAXCAND (LPR_NORDERS * 8)
-
-struct cand {
-	int order, ri;
-};
 
 struct shared {
 	const struct lpr_image *img, *feat;
 	const struct lpr_params *p;
 	struct lpr_result *out;
-	int ncand;
-	struct cand cand[MAXCAND];        /* in order of preference */
-	int candidx[LPR_NORDERS][8];      /* (order, radius index) -> cand, or -1 */
-	int nr, maxorder, s;
+	int nr, omin, omax, s;
 	struct lpr_filters filt[8];
 	float *clean;                     /* holes replaced by 0 */
 	int *sat;                         /* summed-area table of invalid pixels */
 	unsigned char *valid;
-	int nstrips, next, failed;
-	long fast, general;
+	int nstrips, next;
 	pthread_mutex_t lock;
 };
 
 struct worker {
 	struct shared *sh;
-	size_t npx;
+	size_t npx;                       /* pixels of the fitted rows */
 	float *store;
-	struct lpr_cand_buf buf[MAXCAND];
+	struct lpr_cand_buf buf[LPR_NORDERS]; /* the current radius, per order */
 	unsigned char *elig;
 	double *fscratch;
 	float *hn;          /* smoothing: 3 horizontal sums per pixel */
 	float *pad;         /* smoothing: 3 padded rows */
-	float *cv, *qs;     /* smoothed PRESS and noise, STRIP_ROWS * w per cand */
+	float *cv, *qs;     /* smoothed PRESS and noise, STRIP_ROWS * w per order */
+	double *score;      /* best score so far, STRIP_ROWS * w */
+	int *key;           /* its tie-break key; KEY_NONE, or fallback keys */
+	float *mag2;        /* mean square of the pixel's values */
 	long fast, general;
 };
+
+#define KEY_NONE 0x7fffffff
+#define KEY_FALLBACK (1 << 20)
 
 static void seterr(char *err, size_t len, const char *fmt, ...)
 {
@@ -120,56 +124,48 @@ static void write_general(struct lpr_cand_buf *b, size_t i, int nch, const struc
 	b->q[i] = f->valid ? (float)f->noise : NAN;
 }
 
-/* Fit every candidate on rows [ya, yb). */
-static void fit_rows(struct worker *wk, int ya, int yb)
+/* Fit the candidates of radius index ri, every order, on rows [ya, yb). */
+static void fit_radius(struct worker *wk, int ri, int ya, int yb)
 {
 	struct shared *sh = wk->sh;
 	const struct lpr_image *img = sh->img;
 	const int w = img->w, h = img->h, nch = img->nch;
-	int use_fast = !sh->feat && !sh->p->force_general;
+	const int use_fast = !sh->feat && !sh->p->force_general;
+	const struct lpr_filters *f = &sh->filt[ri];
+	const int r = f->r;
+	struct lpr_cand_buf *cb[LPR_NORDERS];
+	for (int o = 0; o < LPR_NORDERS; o++)
+		cb[o] = o >= sh->omin && o <= sh->omax ? &wk->buf[o] : NULL;
 
-	for (int ri = 0; ri < sh->nr; ri++) {
-		const struct lpr_filters *f = &sh->filt[ri];
-		const int r = f->r;
-		struct lpr_cand_buf *cb[LPR_NORDERS];
-		for (int o = 0; o < LPR_NORDERS; o++)
-			cb[o] = sh->candidx[o][ri] >= 0 ? &wk->buf[sh->candidx[o][ri]] : NULL;
-
-		/* elig: 1 fast path, 2 clipped but unmasked, 0 general. */
-		for (int y = ya; y < yb; y++)
-			for (int x = 0; x < w; x++) {
-				int x0 = x - r < 0 ? 0 : x - r, x1 = x + r >= w ? w - 1 : x + r;
-				int y0 = y - r < 0 ? 0 : y - r, y1 = y + r >= h ? h - 1 : y + r;
-				int clean = !invalid_in(sh, x0, y0, x1, y1);
-				int inside = x0 == x - r && x1 == x + r && y0 == y - r && y1 == y + r;
-				unsigned char e = clean ? (inside && use_fast ? 1 : 2) : 0;
-				wk->elig[(size_t)(y - ya) * w + x] = e;
-			}
-		if (use_fast)
-			wk->fast += lpr_fast_strip(f, sh->clean, w, h, nch, ya, yb, wk->elig,
-						   wk->fscratch, cb);
-		int maxo = sh->maxorder < 1 ? 1 : sh->maxorder;
-		for (int y = ya; y < yb; y++)
-			for (int x = 0; x < w; x++) {
-				size_t i = (size_t)(y - ya) * w + x;
-				if (wk->elig[i] == 1)
-					continue;
-				struct lpr_fit fits[LPR_NORDERS];
-				lpr_general_fits(img, sh->feat, x, y, r, maxo,
-						 wk->elig[i] == 2 && !sh->p->force_general, fits);
-				for (int o = 0; o < LPR_NORDERS; o++)
-					if (cb[o])
-						write_general(cb[o], i, nch, &fits[o]);
-				wk->general++;
-			}
-	}
+	/* elig: 1 fast path, 2 clipped but unmasked, 0 general. */
+	for (int y = ya; y < yb; y++)
+		for (int x = 0; x < w; x++) {
+			int x0 = x - r < 0 ? 0 : x - r, x1 = x + r >= w ? w - 1 : x + r;
+			int y0 = y - r < 0 ? 0 : y - r, y1 = y + r >= h ? h - 1 : y + r;
+			int clean = !invalid_in(sh, x0, y0, x1, y1);
+			int inside = x0 == x - r && x1 == x + r && y0 == y - r && y1 == y + r;
+			unsigned char e = clean ? (inside && use_fast ? 1 : 2) : 0;
+			wk->elig[(size_t)(y - ya) * w + x] = e;
+		}
+	if (use_fast)
+		wk->fast += lpr_fast_strip(f, sh->clean, w, h, nch, ya, yb, wk->elig,
+					   wk->fscratch, cb);
+	int maxo = sh->omax < 1 ? 1 : sh->omax;
+	for (int y = ya; y < yb; y++)
+		for (int x = 0; x < w; x++) {
+			size_t i = (size_t)(y - ya) * w + x;
+			if (wk->elig[i] == 1)
+				continue;
+			struct lpr_fit fits[LPR_NORDERS];
+			lpr_general_fits(img, sh->feat, x, y, r, maxo,
+					 wk->elig[i] == 2 && !sh->p->force_general, fits);
+			for (int o = 0; o < LPR_NORDERS; o++)
+				if (cb[o])
+					write_general(cb[o], i, nch, &fits[o]);
+			wk->general++;
+		}
 }
 
-/*
- * Average e2 and q of candidate b over the tricube neighbourhood of radius
- * s, leaving out entries that are not finite; rows [y0, y1) of the output,
- * from the fitted rows [ya, yb).
- */
 /* o[x] = sum_i t[i] in[x + i] for i in [0, n): in is padded. */
 static void conv_row(float *restrict o, const float *restrict in, int w,
 		     const float *restrict t, int n)
@@ -240,74 +236,120 @@ static void smooth(struct worker *wk, const struct lpr_cand_buf *b, int ya, int 
 	}
 }
 
-static void select_rows(struct worker *wk, int ya, int y0, int y1)
+static void put_choice(struct worker *wk, const struct lpr_cand_buf *b, size_t li,
+		       size_t gi, int order, int r, float error)
+{
+	struct lpr_result *out = wk->sh->out;
+	const int nch = wk->sh->img->nch;
+	for (int c = 0; c < nch; c++) {
+		out->fit[gi * nch + c] = b->fit[li * nch + c];
+		out->dx[gi * nch + c] = b->dx[li * nch + c];
+		out->dy[gi * nch + c] = b->dy[li * nch + c];
+	}
+	out->leverage[gi] = b->lev[li];
+	out->error[gi] = error;
+	out->order[gi] = (float)order;
+	out->bandwidth[gi] = (float)r;
+}
+
+/* Fold the candidates of radius index ri into the best choice so far. */
+static void update_best(struct worker *wk, int ri, int ya, int y0, int y1)
+{
+	struct shared *sh = wk->sh;
+	const int w = sh->img->w, nch = sh->img->nch, r = sh->filt[ri].r;
+	const size_t sp = (size_t)STRIP_ROWS * w;
+	const double tol = sh->p->tie_tol;
+
+	for (int o = sh->omin; o <= sh->omax; o++) {
+		const int key = o * 64 + (LPR_MAXRADIUS - r);
+		const float *cv = wk->cv + o * sp, *qs = wk->qs + o * sp;
+		for (int y = y0; y < y1; y++)
+			for (int x = 0; x < w; x++) {
+				size_t li = (size_t)(y - ya) * w + x;  /* fitted-rows index */
+				size_t si = (size_t)(y - y0) * w + x;  /* strip index */
+				size_t gi = (size_t)y * w + x;         /* image index */
+				const struct lpr_cand_buf *b = &wk->buf[o];
+				/* Order 1 on the fast path is order 0 (see fastpath.c). */
+				if (isnan(b->fit[li * nch]) && o == 1 && isfinite(b->e2[li]))
+					b = &wk->buf[0];
+				if (isnan(b->fit[li * nch]))
+					continue;
+				if (isnan(wk->mag2[si])) {
+					double m2 = 0.0;
+					for (int c = 0; c < nch; c++)
+						m2 += (double)b->fit[li * nch + c] * b->fit[li * nch + c];
+					wk->mag2[si] = (float)(m2 / nch);
+				}
+				if (!isfinite(cv[si])) {
+					/* Fitted but without a criterion: a fallback. */
+					int fk = KEY_FALLBACK + key;
+					if (wk->key[si] >= KEY_FALLBACK && fk < wk->key[si]) {
+						wk->key[si] = fk;
+						put_choice(wk, b, li, gi, o, 0, 0.0f);
+					}
+					continue;
+				}
+				double score = cv[si] * (1.0 + tol * o) + 1e-12 * wk->mag2[si] * o;
+				if (score < wk->score[si] || (score == wk->score[si] && key < wk->key[si])) {
+					wk->score[si] = score;
+					wk->key[si] = key;
+					put_choice(wk, b, li, gi, o, r, qs[si]);
+				}
+			}
+	}
+}
+
+/* Pixels no candidate could fit: keep the sample, or NaN for a hole. */
+static void finish_rows(struct worker *wk, int y0, int y1)
 {
 	struct shared *sh = wk->sh;
 	const struct lpr_image *img = sh->img;
 	const int w = img->w, nch = img->nch;
-	const size_t sp = (size_t)STRIP_ROWS * w;
 	struct lpr_result *out = sh->out;
-	const double tol = sh->p->tie_tol;
+	for (int y = y0; y < y1; y++)
+		for (int x = 0; x < w; x++) {
+			size_t si = (size_t)(y - y0) * w + x, gi = (size_t)y * w + x;
+			if (wk->key[si] != KEY_NONE)
+				continue;
+			int ok = sh->valid[gi];
+			for (int c = 0; c < nch; c++) {
+				out->fit[gi * nch + c] = ok ? img->px[gi * nch + c] : NAN;
+				out->dx[gi * nch + c] = ok ? 0.0f : NAN;
+				out->dy[gi * nch + c] = ok ? 0.0f : NAN;
+			}
+			out->leverage[gi] = ok ? 1.0f : NAN;
+			out->error[gi] = ok ? 0.0f : NAN;
+			out->order[gi] = 0.0f;
+			out->bandwidth[gi] = 0.0f;
+		}
+}
+
+static void do_strip(struct worker *wk, int st)
+{
+	struct shared *sh = wk->sh;
+	const struct lpr_image *img = sh->img;
+	const int h = img->h, w = img->w, nch = img->nch;
+	const int y0 = st * STRIP_ROWS, y1 = y0 + STRIP_ROWS > h ? h : y0 + STRIP_ROWS;
+	const int ya = y0 - sh->s < 0 ? 0 : y0 - sh->s, yb = y1 + sh->s > h ? h : y1 + sh->s;
+	const size_t sp = (size_t)STRIP_ROWS * w;
 
 	for (int y = y0; y < y1; y++)
 		for (int x = 0; x < w; x++) {
-			size_t li = (size_t)(y - ya) * w + x;   /* fitted-rows index */
-			size_t si = (size_t)(y - y0) * w + x;   /* strip index */
-			size_t gi = (size_t)y * w + x;          /* image index */
-			int best = -1, first = -1;
-			double bestcv = 0.0, floor_ = 0.0;
-			for (int k = 0; k < sh->ncand; k++) {
-				if (!isfinite(wk->buf[k].fit[li * nch]))
-					continue;
-				if (first < 0) {
-					first = k;
-					double m2 = 0.0;
-					for (int c = 0; c < nch; c++) {
-						double v = wk->buf[k].fit[li * nch + c];
-						m2 += v * v;
-					}
-					/* Differences below float resolution are ties. */
-					floor_ = 1e-12 * m2 / nch;
-				}
-				double cv = wk->cv[k * sp + si];
-				if (!isfinite(cv))
-					continue;
-				if (best < 0 || cv < bestcv * (1.0 - tol) - floor_) {
-					best = k;
-					bestcv = cv;
-				}
-			}
-			int k = best >= 0 ? best : first;
-			if (k >= 0) {
-				const struct lpr_cand_buf *b = &wk->buf[k];
-				for (int c = 0; c < nch; c++) {
-					out->fit[gi * nch + c] = b->fit[li * nch + c];
-					out->dx[gi * nch + c] = b->dx[li * nch + c];
-					out->dy[gi * nch + c] = b->dy[li * nch + c];
-				}
-				out->leverage[gi] = b->lev[li];
-				out->order[gi] = (float)sh->cand[k].order;
-				if (best >= 0) {
-					out->error[gi] = wk->qs[k * sp + si];
-					out->bandwidth[gi] = (float)sh->filt[sh->cand[k].ri].r;
-				} else {
-					out->error[gi] = 0.0f;
-					out->bandwidth[gi] = 0.0f;
-				}
-			} else {
-				/* Nothing to fit: keep the sample, or NaN for a hole. */
-				int ok = sh->valid[gi];
-				for (int c = 0; c < nch; c++) {
-					out->fit[gi * nch + c] = ok ? img->px[gi * nch + c] : NAN;
-					out->dx[gi * nch + c] = ok ? 0.0f : NAN;
-					out->dy[gi * nch + c] = ok ? 0.0f : NAN;
-				}
-				out->leverage[gi] = ok ? 1.0f : NAN;
-				out->error[gi] = ok ? 0.0f : NAN;
-				out->order[gi] = 0.0f;
-				out->bandwidth[gi] = 0.0f;
-			}
+			size_t si = (size_t)(y - y0) * w + x, gi = (size_t)y * w + x;
+			wk->score[si] = INFINITY;
+			wk->key[si] = KEY_NONE;
+			double m2 = 0.0;
+			for (int c = 0; c < nch; c++)
+				m2 += (double)img->px[gi * nch + c] * img->px[gi * nch + c];
+			wk->mag2[si] = sh->valid[gi] ? (float)(m2 / nch) : NAN;
 		}
+	for (int ri = 0; ri < sh->nr; ri++) {
+		fit_radius(wk, ri, ya, yb);
+		for (int o = sh->omin; o <= sh->omax; o++)
+			smooth(wk, &wk->buf[o], ya, yb, y0, y1, wk->cv + o * sp, wk->qs + o * sp);
+		update_best(wk, ri, ya, y0, y1);
+	}
+	finish_rows(wk, y0, y1);
 }
 
 static void *work(void *arg)
@@ -320,14 +362,7 @@ static void *work(void *arg)
 		pthread_mutex_unlock(&sh->lock);
 		if (st >= sh->nstrips)
 			break;
-		int h = sh->img->h, w = sh->img->w;
-		int y0 = st * STRIP_ROWS, y1 = y0 + STRIP_ROWS > h ? h : y0 + STRIP_ROWS;
-		int ya = y0 - sh->s < 0 ? 0 : y0 - sh->s, yb = y1 + sh->s > h ? h : y1 + sh->s;
-		fit_rows(wk, ya, yb);
-		const size_t sp = (size_t)STRIP_ROWS * w;
-		for (int k = 0; k < sh->ncand; k++)
-			smooth(wk, &wk->buf[k], ya, yb, y0, y1, wk->cv + k * sp, wk->qs + k * sp);
-		select_rows(wk, ya, y0, y1);
+		do_strip(wk, st);
 	}
 	return NULL;
 }
@@ -339,8 +374,9 @@ static int worker_init(struct worker *wk, struct shared *sh)
 	const int w = sh->img->w, nch = sh->img->nch;
 	const int rows = STRIP_ROWS + 2 * sh->s;
 	wk->npx = (size_t)rows * w;
+	const size_t sp = (size_t)STRIP_ROWS * w;
 	size_t per = wk->npx * (3 * (size_t)nch + 3);
-	wk->store = malloc(per * sh->ncand * sizeof(float));
+	wk->store = malloc(per * LPR_NORDERS * sizeof(float));
 	wk->elig = malloc(wk->npx);
 	int rmax = 0;
 	for (int i = 0; i < sh->nr; i++)
@@ -348,11 +384,15 @@ static int worker_init(struct worker *wk, struct shared *sh)
 	wk->fscratch = malloc(lpr_fast_scratch(w, nch, rows, rmax) * sizeof(double));
 	wk->hn = malloc(3 * wk->npx * sizeof(float));
 	wk->pad = malloc(3 * ((size_t)w + 2 * LPR_MAXRADIUS) * sizeof(float));
-	wk->cv = malloc((size_t)sh->ncand * STRIP_ROWS * w * sizeof(float));
-	wk->qs = malloc((size_t)sh->ncand * STRIP_ROWS * w * sizeof(float));
-	if (!wk->store || !wk->elig || !wk->fscratch || !wk->hn || !wk->pad || !wk->cv || !wk->qs)
+	wk->cv = malloc(LPR_NORDERS * sp * sizeof(float));
+	wk->qs = malloc(LPR_NORDERS * sp * sizeof(float));
+	wk->score = malloc(sp * sizeof(double));
+	wk->key = malloc(sp * sizeof(int));
+	wk->mag2 = malloc(sp * sizeof(float));
+	if (!wk->store || !wk->elig || !wk->fscratch || !wk->hn || !wk->pad || !wk->cv ||
+	    !wk->qs || !wk->score || !wk->key || !wk->mag2)
 		return -1;
-	for (int k = 0; k < sh->ncand; k++) {
+	for (int k = 0; k < LPR_NORDERS; k++) {
 		float *b = wk->store + per * k;
 		wk->buf[k].fit = b;
 		wk->buf[k].dx = b + wk->npx * nch;
@@ -373,6 +413,9 @@ static void worker_release(struct worker *wk)
 	free(wk->pad);
 	free(wk->cv);
 	free(wk->qs);
+	free(wk->score);
+	free(wk->key);
+	free(wk->mag2);
 }
 
 static int check_args(const struct lpr_image *img, const struct lpr_image *feat,
@@ -497,24 +540,8 @@ int lpr_analyze(const struct lpr_image *img, const struct lpr_image *features,
 	sh->nr = p->radius ? 1 : p->nradii;
 	for (int i = 0; i < sh->nr; i++)
 		lpr_filters_init(&sh->filt[i], p->radius ? p->radius : p->radii[i]);
-	int omin = p->order < 0 ? 0 : p->order, omax = p->order < 0 ? 2 : p->order;
-	sh->maxorder = omax;
-	memset(sh->candidx, -1, sizeof sh->candidx);
-	/* Preference: lower order first, then the larger radius. */
-	int rorder[8];
-	for (int i = 0; i < sh->nr; i++)
-		rorder[i] = i;
-	for (int i = 1; i < sh->nr; i++)
-		for (int j = i; j > 0 && sh->filt[rorder[j]].r > sh->filt[rorder[j - 1]].r; j--) {
-			int t = rorder[j];
-			rorder[j] = rorder[j - 1];
-			rorder[j - 1] = t;
-		}
-	for (int o = omin; o <= omax; o++)
-		for (int i = 0; i < sh->nr; i++) {
-			sh->candidx[o][rorder[i]] = sh->ncand;
-			sh->cand[sh->ncand++] = (struct cand){ o, rorder[i] };
-		}
+	sh->omin = p->order < 0 ? 0 : p->order;
+	sh->omax = p->order < 0 ? 2 : p->order;
 
 	int nth = p->nthreads;
 	if (nth <= 0) {
