@@ -20,7 +20,7 @@ UNIT_SRC = $(wildcard tests/test_*.c)
 UNIT_BIN = $(UNIT_SRC:tests/%.c=$(BUILD)/tests/%)
 TOOL_BIN = $(BUILD)/tests/gen_image $(BUILD)/bench/bench_analyze
 
-.PHONY: all check unit e2e bench clean deps
+.PHONY: all check unit e2e bench clean deps demo
 all: $(BUILD)/povpress
 
 # The Debian packages are installed (when missing) once per build tree.
@@ -58,6 +58,9 @@ check: unit e2e
 
 bench: $(BUILD)/bench/bench_analyze
 	$(BUILD)/bench/bench_analyze
+
+demo: $(BUILD)/povpress
+	scripts/demo.sh $(BUILD)
 
 clean:
 	rm -rf $(BUILD)

@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "driver/commands.h"
@@ -11,7 +12,7 @@
 #include "driver/metrics.h"
 
 static const char compare_usage[] =
-	"usage: povpress compare IMAGE.exr REF.exr\n"
+	"usage: povpress compare IMAGE.exr REF.exr [--analysis ANALYSIS.exr]\n"
 	"\n"
 	"Print the error of IMAGE against the reference REF over the R, G, B\n"
 	"channels (a lone Y channel stands for all three):\n"
@@ -21,7 +22,15 @@ static const char compare_usage[] =
 	"  psnr: V     10 log10(1 / mse), peak 1; inf when mse is 0\n"
 	"\n"
 	"Pixels that are NaN or infinite in either image are left out, and a\n"
-	"fourth line \"skipped: N\" counts them.\n";
+	"fourth line \"skipped: N\" counts them.\n"
+	"\n"
+	"With --analysis, the output of 'povpress analyze IMAGE.exr' is judged as\n"
+	"a prediction of IMAGE's true error (its error and R, G, B channels):\n"
+	"\n"
+	"  est_relmse: V  the relMSE the error map predicts for IMAGE\n"
+	"  capture20: V   share of the true error in the 20% of pixels the map\n"
+	"                 ranks highest\n"
+	"  oracle20: V    the same share for a perfect ranking\n";
 
 /* Read path and reduce it to R, G, B; prints the error itself. */
 static int load_rgb(const char *path, struct image *rgb)
@@ -43,8 +52,8 @@ static int load_rgb(const char *path, struct image *rgb)
 
 int cmd_compare(int argc, char **argv)
 {
-	struct image img = { 0 }, ref = { 0 };
-	const char *paths[2];
+	struct image img = { 0 }, ref = { 0 }, ana = { 0 }, fit = { 0 };
+	const char *paths[2], *analysis = NULL;
 	struct metrics m;
 	char err[1024];
 	int npaths = 0, options_done = 0, ret = 1;
@@ -60,6 +69,10 @@ int cmd_compare(int argc, char **argv)
 			if (!strcmp(arg, "--help") || !strcmp(arg, "-h")) {
 				fputs(compare_usage, stdout);
 				return 0;
+			}
+			if (!strcmp(arg, "--analysis") && i + 1 < argc) {
+				analysis = argv[++i];
+				continue;
 			}
 			fprintf(stderr, "povpress compare: unknown option '%s'\n\n", arg);
 			fputs(compare_usage, stderr);
@@ -98,6 +111,37 @@ int cmd_compare(int argc, char **argv)
 		printf("psnr: %.6g\n", m.psnr);
 	if (m.skipped)
 		printf("skipped: %zu\n", m.skipped);
+	if (analysis) {
+		struct fidelity fd;
+		int ech;
+		if (image_read_exr(analysis, &ana, err, sizeof(err)) ||
+		    image_rgb(&ana, analysis, &fit, err, sizeof(err))) {
+			fprintf(stderr, "povpress compare: %s\n", err);
+			goto out;
+		}
+		ech = image_channel(&ana, "error");
+		if (ech < 0) {
+			fprintf(stderr, "povpress compare: '%s' has no error channel\n", analysis);
+			goto out;
+		}
+		size_t n = (size_t)ana.w * ana.h;
+		float *emap = malloc(n * sizeof(float));
+		if (!emap) {
+			fprintf(stderr, "povpress compare: out of memory\n");
+			goto out;
+		}
+		for (size_t i = 0; i < n; i++)
+			emap[i] = ana.px[i * ana.nch + ech];
+		int rc = metrics_fidelity(&img, &ref, emap, &fit, &fd, err, sizeof(err));
+		free(emap);
+		if (rc) {
+			fprintf(stderr, "povpress compare: cannot judge '%s': %s\n", analysis, err);
+			goto out;
+		}
+		printf("est_relmse: %.6g\n", fd.est_relmse);
+		printf("capture20: %.4f\n", fd.capture);
+		printf("oracle20: %.4f\n", fd.oracle);
+	}
 	if (fflush(stdout) || ferror(stdout)) {
 		fprintf(stderr, "povpress compare: cannot write output: %s\n", strerror(errno));
 		goto out;
@@ -106,5 +150,7 @@ int cmd_compare(int argc, char **argv)
 out:
 	image_release(&img);
 	image_release(&ref);
+	image_release(&ana);
+	image_release(&fit);
 	return ret;
 }

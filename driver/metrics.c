@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 int metrics_compute(const struct image *img, const struct image *ref, struct metrics *out,
@@ -54,5 +55,78 @@ int metrics_compute(const struct image *img, const struct image *ref, struct met
 	out->mse = sum_sq / ((double)out->compared * (double)nch);
 	out->relmse = sum_rel / ((double)out->compared * (double)nch);
 	out->psnr = out->mse > 0.0 ? 10.0 * log10(1.0 / out->mse) : INFINITY;
+	return 0;
+}
+
+struct ranked {
+	double key, truth;
+};
+
+static int by_key_desc(const void *a, const void *b)
+{
+	double x = ((const struct ranked *)a)->key, y = ((const struct ranked *)b)->key;
+	return x < y ? 1 : x > y ? -1 : 0;
+}
+
+/* Share of the truth in the first 20% of v after sorting by key. */
+static double top_share(struct ranked *v, size_t n, double total)
+{
+	qsort(v, n, sizeof *v, by_key_desc);
+	size_t top = (n + 4) / 5;
+	double s = 0.0;
+	for (size_t i = 0; i < top; i++)
+		s += v[i].truth;
+	return total > 0.0 ? s / total : 1.0;
+}
+
+int metrics_fidelity(const struct image *img, const struct image *ref, const float *err_map,
+		     const struct image *fit, struct fidelity *out, char *err, size_t errlen)
+{
+	memset(out, 0, sizeof(*out));
+	if (img->w != ref->w || img->h != ref->h || fit->w != img->w || fit->h != img->h ||
+	    img->nch != 3 || ref->nch != 3 || fit->nch != 3) {
+		if (err && errlen)
+			snprintf(err, errlen, "the image, reference and analysis differ in size");
+		return -1;
+	}
+	size_t npix = (size_t)img->w * (size_t)img->h, n = 0;
+	struct ranked *v = malloc(npix * sizeof *v);
+	if (!v) {
+		if (err && errlen)
+			snprintf(err, errlen, "out of memory");
+		return -1;
+	}
+	double total = 0.0, est = 0.0;
+	for (size_t i = 0; i < npix; i++) {
+		const float *a = img->px + 3 * i, *b = ref->px + 3 * i, *f = fit->px + 3 * i;
+		double t = 0.0, m2 = 0.0;
+		int ok = isfinite(err_map[i]);
+		for (int c = 0; c < 3; c++) {
+			ok = ok && isfinite(a[c]) && isfinite(b[c]) && isfinite(f[c]);
+			double d = (double)a[c] - b[c];
+			t += d * d / ((double)b[c] * b[c] + METRICS_RELMSE_EPS);
+			m2 += (double)f[c] * f[c];
+		}
+		if (!ok)
+			continue;
+		v[n].truth = t / 3.0;
+		v[n].key = err_map[i] / (m2 / 3.0 + METRICS_RELMSE_EPS);
+		total += v[n].truth;
+		est += v[n].key;
+		n++;
+	}
+	if (!n) {
+		free(v);
+		if (err && errlen)
+			snprintf(err, errlen, "no pixel is finite in all images");
+		return -1;
+	}
+	out->true_relmse = total / n;
+	out->est_relmse = est / n;
+	out->capture = top_share(v, n, total);
+	for (size_t i = 0; i < n; i++)
+		v[i].key = v[i].truth;
+	out->oracle = top_share(v, n, total);
+	free(v);
 	return 0;
 }

@@ -31,4 +31,27 @@ struct metrics {
 int metrics_compute(const struct image *img, const struct image *ref, struct metrics *out,
 		    char *err, size_t errlen);
 
+/*
+ * How well an error map predicts the true error of img against ref.
+ * Per pixel, the true error is mean_c (x - ref)^2 / (ref^2 + eps) (its
+ * relMSE term) and the estimate is est / (mean_c fit^2 + eps), with est the
+ * estimated squared error and fit the reconstruction standing in for the
+ * unknown reference.
+ */
+struct fidelity {
+	double capture;      /* share of the true error in the top 20% by estimate */
+	double oracle;       /* the same share, ranking by the true error itself */
+	double est_relmse;   /* mean estimated relMSE term */
+	double true_relmse;  /* mean true relMSE term */
+};
+
+/*
+ * Compute the fidelity of the estimate err_map (w * h values) with
+ * reconstruction fit (RGB, same size) for img against ref (both RGB).
+ * Pixels with a non-finite value anywhere are left out.  Returns 0, or -1
+ * with a message on a size mismatch, no usable pixel or no memory.
+ */
+int metrics_fidelity(const struct image *img, const struct image *ref, const float *err_map,
+		     const struct image *fit, struct fidelity *out, char *err, size_t errlen);
+
 #endif

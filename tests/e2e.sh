@@ -90,6 +90,12 @@ m=$(cmpval "$out" mse)
 check "noise: reconstruction MSE <= sigma^2/4 ($m)" num 'a <= 0.000625' "$m"
 check "compare prints relmse, mse, psnr" sh -c "printf '%s\n' \"$out\" | awk '\$1==\"relmse:\"{a=1} \$1==\"mse:\"{b=1} \$1==\"psnr:\"{c=1} END{exit !(a&&b&&c)}'"
 
+out=$("$PP" compare "$T/noise.exr" "$T/half.exr" --analysis "$T/noise.a.exr")
+check "compare --analysis: estimated relMSE within 25% of the true one on noise" \
+	num 'a >= 0.75 * b && a <= 1.25 * b' "$(cmpval "$out" est_relmse)" "$(cmpval "$out" relmse)"
+check "compare --analysis: capture and oracle shares in (0, 1], capture <= oracle" \
+	num 'a > 0 && b <= 1 && a <= b' "$(cmpval "$out" capture20)" "$(cmpval "$out" oracle20)"
+
 # --- scale invariance --------------------------------------------------------
 oiiotool "$T/noise.exr" --mulc 1e4 -d float -o "$T/noise4.exr"
 "$PP" analyze "$T/noise4.exr" -o "$T/noise4.a.exr"
