@@ -44,7 +44,7 @@ int image_channel(const struct image *img, const char *name);
 int image_read_exr(const char *path, struct image *out, char *err, size_t errlen);
 
 /*
- * Write img as a single-part scanline EXR, 32-bit float, ZIP compression,
+ * Write img as a single-part scanline EXR, 32-bit float, PIZ compression,
  * one channel per img channel with img's names (OpenEXR stores channels
  * sorted by name, so image_read_exr() returns them in that order).  Names
  * must be distinct and non-empty.  The data is written to a temporary file
