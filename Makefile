@@ -21,6 +21,7 @@ UNIT_BIN = $(UNIT_SRC:tests/%.c=$(BUILD)/tests/%)
 TOOL_BIN = $(BUILD)/tests/gen_image $(BUILD)/bench/bench_analyze
 
 .PHONY: all check unit e2e bench clean deps demo
+.SECONDARY:
 all: $(BUILD)/povpress
 
 # The Debian packages are installed (when missing) once per build tree.
