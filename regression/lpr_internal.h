@@ -3,6 +3,7 @@
 #define LPR_INTERNAL_H
 
 #include "regression/lpr.h"
+#include "regression/wls.h"
 
 #define LPR_NORDERS 3
 
@@ -24,7 +25,45 @@ int lpr_sample_valid(const struct lpr_image *img, const struct lpr_image *feat, 
 void lpr_general_fits(const struct lpr_image *img, const struct lpr_image *feat,
 		      int x, int y, int r, int maxorder, int unmasked, struct lpr_fit *out);
 
-#endif
+
+
+/*
+ * The normal equations of one window without its centre sample, in the
+ * columns 1, u, v, u^2, uv, v^2, then nf standardised features (p = 6 + nf,
+ * row-major p x p), however they were accumulated.
+ */
+struct lpr_system {
+	int nf, nch;
+	int n;                               /* samples, centre excluded */
+	double sw;                           /* their total weight */
+	double a[WLS_MAXP * WLS_MAXP];       /* A' = sum W x x^T */
+	double b[LPR_MAXCH][WLS_MAXP];       /* b' = sum W x Y, per channel */
+	double bq[WLS_MAXP * WLS_MAXP];      /* B' = sum W^2 x x^T, if have_bq */
+	int have_bq;
+};
+
+struct lpr_solution {
+	double z[LPR_NORDERS][WLS_MAXP];               /* A'^-1 e_0 */
+	double beta[LPR_NORDERS][LPR_MAXCH][WLS_MAXP]; /* A'^-1 b' */
+	double vsum[LPR_NORDERS];                      /* z^T B' z */
+	double rss[LPR_NORDERS][LPR_MAXCH];            /* weighted residuals (holes) */
+};
+
+/*
+ * Factor and solve sys for orders 0 .. maxorder, setting out[o].valid,
+ * .rank and .hole; vsum is filled when sys has B', else left 0 (as is rss)
+ * for the caller to accumulate.
+ */
+void lpr_system_solve(const struct lpr_system *sys, int maxorder, int hole,
+		      struct lpr_fit *out, struct lpr_solution *sol);
+
+/*
+ * Turn a solution into fits: leave-one-out prediction, fit, leverage,
+ * slopes, PRESS and noise terms (see window.c).  yc is the centre sample
+ * (ignored for a hole), r the radius.
+ */
+void lpr_system_finish(const struct lpr_system *sys, const float *yc, int hole, int r,
+		       int maxorder, const struct lpr_solution *sol, struct lpr_fit *out);
 
 /* Per-candidate results for the rows of one strip; NaN marks "no fit". */
 struct lpr_cand_buf {
@@ -50,6 +89,9 @@ struct lpr_filters {
 
 void lpr_filters_init(struct lpr_filters *f, int r);
 
+/* Store a general-path fit (NaN everywhere when it is not valid). */
+void lpr_cand_write(struct lpr_cand_buf *b, size_t i, int nch, const struct lpr_fit *f);
+
 /* Scratch the fast path needs for a strip of nrows rows, in doubles. */
 size_t lpr_fast_scratch(int w, int nch, int nrows, int r);
 
@@ -64,3 +106,19 @@ size_t lpr_fast_scratch(int w, int nch, int nrows, int r);
 long lpr_fast_strip(const struct lpr_filters *f, const float *clean, int w, int h,
 		    int nch, int ya, int yb, const unsigned char *elig,
 		    double *scratch, struct lpr_cand_buf *const c[LPR_NORDERS]);
+
+/* Scratch lpr_feat_strip needs, in doubles. */
+size_t lpr_feat_scratch(int w, int nch, int nf, int nrows, int r);
+
+/*
+ * Fit, with the features of feat, every pixel of rows [ya, yb) whose elig
+ * flag is non-zero (its window holds no missing sample), for orders
+ * 0 .. maxorder, writing c[0..2] (an entry may be NULL).  Returns the
+ * number of pixels fitted.
+ */
+long lpr_feat_strip(const struct lpr_filters *f, const struct lpr_image *img,
+		    const float *clean, const struct lpr_image *feat, int ya, int yb,
+		    const unsigned char *elig, double *scratch,
+		    struct lpr_cand_buf *const c[LPR_NORDERS], int maxorder);
+
+#endif

@@ -112,7 +112,7 @@ static int invalid_in(const struct shared *sh, int x0, int y0, int x1, int y1)
 	       s[(size_t)(y1 + 1) * W + x0] + s[(size_t)y0 * W + x0];
 }
 
-static void write_general(struct lpr_cand_buf *b, size_t i, int nch, const struct lpr_fit *f)
+void lpr_cand_write(struct lpr_cand_buf *b, size_t i, int nch, const struct lpr_fit *f)
 {
 	for (int c = 0; c < nch; c++) {
 		b->fit[i * nch + c] = f->valid ? (float)f->fit[c] : NAN;
@@ -150,18 +150,22 @@ static void fit_radius(struct worker *wk, int ri, int ya, int yb)
 	if (use_fast)
 		wk->fast += lpr_fast_strip(f, sh->clean, w, h, nch, ya, yb, wk->elig,
 					   wk->fscratch, cb);
+	int use_feat = sh->feat && !sh->p->force_general;
+	if (use_feat)
+		wk->fast += lpr_feat_strip(f, img, sh->clean, sh->feat, ya, yb, wk->elig,
+					   wk->fscratch, cb, sh->omax < 1 ? 1 : sh->omax);
 	int maxo = sh->omax < 1 ? 1 : sh->omax;
 	for (int y = ya; y < yb; y++)
 		for (int x = 0; x < w; x++) {
 			size_t i = (size_t)(y - ya) * w + x;
-			if (wk->elig[i] == 1)
+			if (wk->elig[i] == 1 || (use_feat && wk->elig[i]))
 				continue;
 			struct lpr_fit fits[LPR_NORDERS];
 			lpr_general_fits(img, sh->feat, x, y, r, maxo,
 					 wk->elig[i] == 2 && !sh->p->force_general, fits);
 			for (int o = 0; o < LPR_NORDERS; o++)
 				if (cb[o])
-					write_general(cb[o], i, nch, &fits[o]);
+					lpr_cand_write(cb[o], i, nch, &fits[o]);
 			wk->general++;
 		}
 }
@@ -381,7 +385,9 @@ static int worker_init(struct worker *wk, struct shared *sh)
 	int rmax = 0;
 	for (int i = 0; i < sh->nr; i++)
 		rmax = sh->filt[i].r > rmax ? sh->filt[i].r : rmax;
-	wk->fscratch = malloc(lpr_fast_scratch(w, nch, rows, rmax) * sizeof(double));
+	size_t fs = sh->feat ? lpr_feat_scratch(w, nch, sh->feat->nch, rows, rmax)
+			     : lpr_fast_scratch(w, nch, rows, rmax);
+	wk->fscratch = malloc(fs * sizeof(double));
 	wk->hn = malloc(3 * wk->npx * sizeof(float));
 	wk->pad = malloc(3 * ((size_t)w + 2 * LPR_MAXRADIUS) * sizeof(float));
 	wk->cv = malloc(LPR_NORDERS * sp * sizeof(float));

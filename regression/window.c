@@ -167,59 +167,10 @@ static void unmasked_system(const struct lpr_image *img, int x, int y, int r,
 		b[c][0] -= yc[c];
 }
 
-void lpr_general_fits(const struct lpr_image *img, const struct lpr_image *feat,
-		      int x, int y, int r, int maxorder, int unmasked, struct lpr_fit *out)
+void lpr_system_solve(const struct lpr_system *sys, int maxorder, int hole,
+		      struct lpr_fit *out, struct lpr_solution *sol)
 {
-	const int nch = img->nch;
-	double t[2 * LPR_MAXRADIUS + 1];
-	kernel_weights(r, t);
-	int x0 = x - r < 0 ? 0 : x - r, x1 = x + r >= img->w ? img->w - 1 : x + r;
-	int y0 = y - r < 0 ? 0 : y - r, y1 = y + r >= img->h ? img->h - 1 : y + r;
-
-	struct design d = { .r = r };
-	design_features(&d, img, feat, x, y, x0, x1, y0, y1, t);
-	const int p = NSP + d.nf;
-
-	/* Normal equations without the centre sample. */
-	double a[WLS_MAXP * WLS_MAXP] = {0}, b[LPR_MAXCH][WLS_MAXP] = {{0}};
-	double bq[NSP * NSP];
-	double xr[WLS_MAXP], sw = 0.0;
-	int n = 0;
-	unmasked = unmasked && !feat;
-	if (unmasked) {
-		unmasked_system(img, x, y, r, t, x0, x1, y0, y1, a, b, bq);
-		n = (x1 - x0 + 1) * (y1 - y0 + 1) - 1;
-	} else {
-		for (int yy = y0; yy <= y1; yy++)
-			for (int xx = x0; xx <= x1; xx++) {
-				size_t idx = (size_t)yy * img->w + xx;
-				if ((xx == x && yy == y) || !lpr_sample_valid(img, feat, idx))
-					continue;
-				double w = t[xx - x + r] * t[yy - y + r];
-				design_row(&d, feat, idx, xx - x, yy - y, xr);
-				for (int k = 0; k < p; k++) {
-					double wx = w * xr[k];
-					for (int m = k; m < p; m++)
-						a[k * p + m] += wx * xr[m];
-				}
-				const float *yv = img->px + idx * (size_t)nch;
-				for (int c = 0; c < nch; c++)
-					for (int k = 0; k < p; k++)
-						b[c][k] += w * xr[k] * yv[c];
-				sw += w;
-				n++;
-			}
-		for (int k = 0; k < p; k++)
-			for (int m = 0; m < k; m++)
-				a[k * p + m] = a[m * p + k];
-	}
-
-	size_t cidx = (size_t)y * img->w + x;
-	int hole = !lpr_sample_valid(img, NULL, cidx);
-	const float *yc = img->px + cidx * (size_t)nch;
-
-	double z[LPR_NORDERS][WLS_MAXP], beta[LPR_NORDERS][LPR_MAXCH][WLS_MAXP];
-	double vsum[LPR_NORDERS] = {0}, rss[LPR_NORDERS][LPR_MAXCH] = {{0}};
+	const int p = NSP + sys->nf;
 	for (int o = 0; o <= maxorder; o++) {
 		struct lpr_fit *f = &out[o];
 		memset(f, 0, sizeof *f);
@@ -227,93 +178,74 @@ void lpr_general_fits(const struct lpr_image *img, const struct lpr_image *feat,
 		int act[WLS_MAXP], nact = 0, nsp = lpr_nspatial(o);
 		for (int k = 0; k < nsp; k++)
 			act[nact++] = k;
-		for (int k = 0; k < d.nf; k++)
+		for (int k = 0; k < sys->nf; k++)
 			act[nact++] = NSP + k;
 		struct wls_factor fac;
-		f->rank = wls_factor(a, p, act, nact, &fac);
-		int ok = n > 0;
+		f->rank = wls_factor(sys->a, p, act, nact, &fac);
+		int ok = sys->n > 0;
 		for (int k = 0; k < nsp; k++)
 			ok = ok && wls_kept(&fac, k);
 		f->valid = ok;
 		if (!ok)
 			continue;
-		double e0[WLS_MAXP] = {0};
-		e0[0] = 1.0;
-		wls_solve(&fac, e0, z[o]);
-		for (int c = 0; c < nch; c++)
-			wls_solve(&fac, b[c], beta[o][c]);
+		/* One solve for e_0 and every channel's b'. */
+		double rhs[1 + LPR_MAXCH][WLS_MAXP], x[1 + LPR_MAXCH][WLS_MAXP];
+		memset(rhs[0], 0, sizeof rhs[0]);
+		rhs[0][0] = 1.0;
+		for (int c = 0; c < sys->nch; c++)
+			memcpy(rhs[1 + c], sys->b[c], sizeof rhs[0]);
+		wls_solve_n(&fac, 1 + sys->nch, rhs[0], x[0], WLS_MAXP);
+		memcpy(sol->z[o], x[0], sizeof x[0]);
+		for (int c = 0; c < sys->nch; c++)
+			memcpy(sol->beta[o][c], x[1 + c], sizeof x[0]);
+		/* The variance of the leave-one-out prediction is z^T B' z. */
+		sol->vsum[o] = 0.0;
+		if (sys->have_bq)
+			for (int k = 0; k < p; k++)
+				for (int m = 0; m < p; m++)
+					sol->vsum[o] += sol->z[o][k] * sys->bq[k * p + m] * sol->z[o][m];
+		for (int c = 0; c < sys->nch; c++)
+			sol->rss[o][c] = 0.0;
 	}
+}
 
-	/* The variance of the leave-one-out prediction, z^T B' z, and for a
-	 * hole the residuals of the fit: from B' when the window is unmasked,
-	 * else in a second pass over the window. */
-	if (unmasked) {
-		for (int o = 0; o <= maxorder; o++) {
-			if (!out[o].valid)
-				continue;
-			for (int k = 0; k < NSP; k++)
-				for (int m = 0; m < NSP; m++)
-					vsum[o] += z[o][k] * bq[k * NSP + m] * z[o][m];
-		}
-	} else {
-		for (int yy = y0; yy <= y1; yy++)
-			for (int xx = x0; xx <= x1; xx++) {
-				size_t idx = (size_t)yy * img->w + xx;
-				if ((xx == x && yy == y) || !lpr_sample_valid(img, feat, idx))
-					continue;
-				double w = t[xx - x + r] * t[yy - y + r];
-				design_row(&d, feat, idx, xx - x, yy - y, xr);
-				const float *yv = img->px + idx * (size_t)nch;
-				for (int o = 0; o <= maxorder; o++) {
-					if (!out[o].valid)
-						continue;
-					double sz = 0.0;
-					for (int k = 0; k < p; k++)
-						sz += xr[k] * z[o][k];
-					vsum[o] += (w * sz) * (w * sz);
-					if (!hole)
-						continue;
-					for (int c = 0; c < nch; c++) {
-						double fv = 0.0;
-						for (int k = 0; k < p; k++)
-							fv += xr[k] * beta[o][c][k];
-						double res = yv[c] - fv;
-						rss[o][c] += w * res * res;
-					}
-				}
-			}
-	}
-
+void lpr_system_finish(const struct lpr_system *sys, const float *yc, int hole, int r,
+		       int maxorder, const struct lpr_solution *sol, struct lpr_fit *out)
+{
+	const int nch = sys->nch;
 	for (int o = 0; o <= maxorder; o++) {
 		struct lpr_fit *f = &out[o];
 		if (!f->valid)
 			continue;
-		double g = z[o][0];
-		f->vloo = vsum[o];
+		const double *z = sol->z[o];
+		double g = z[0];
+		f->vloo = sol->vsum[o];
 		double press = 0.0, noise = 0.0;
 		if (!hole) {
 			double den = 1.0 + g;   /* centre weight w0 = 1 */
 			f->leverage = g / den;
 			for (int c = 0; c < nch; c++) {
-				double e = yc[c] - beta[o][c][0];
-				f->loo[c] = beta[o][c][0];
+				const double *beta = sol->beta[o][c];
+				double e = yc[c] - beta[0];
+				f->loo[c] = beta[0];
 				f->fit[c] = yc[c] - e / den;
 				double s = e / den;
-				f->dx[c] = (beta[o][c][1] + s * z[o][1]) / r;
-				f->dy[c] = (beta[o][c][2] + s * z[o][2]) / r;
+				f->dx[c] = (beta[1] + s * z[1]) / r;
+				f->dy[c] = (beta[2] + s * z[2]) / r;
 				press += e * e;
 			}
 			press /= nch;
 			noise = press / (1.0 + f->vloo);
 		} else {
 			for (int c = 0; c < nch; c++) {
-				f->loo[c] = f->fit[c] = beta[o][c][0];
-				f->dx[c] = beta[o][c][1] / r;
-				f->dy[c] = beta[o][c][2] / r;
-				noise += rss[o][c];
+				const double *beta = sol->beta[o][c];
+				f->loo[c] = f->fit[c] = beta[0];
+				f->dx[c] = beta[1] / r;
+				f->dy[c] = beta[2] / r;
+				noise += sol->rss[o][c];
 			}
-			if (n > f->rank) {
-				noise = noise / nch / sw * n / (n - f->rank);
+			if (sys->n > f->rank) {
+				noise = noise / nch / sys->sw * sys->n / (sys->n - f->rank);
 				press = noise * (1.0 + f->vloo);
 			} else {
 				noise = press = NAN;
@@ -331,6 +263,94 @@ void lpr_general_fits(const struct lpr_image *img, const struct lpr_image *feat,
 	else if (out[0].valid)
 		for (int c = 0; c < nch; c++)
 			out[0].dx[c] = out[0].dy[c] = 0.0;
+}
+
+void lpr_general_fits(const struct lpr_image *img, const struct lpr_image *feat,
+		      int x, int y, int r, int maxorder, int unmasked, struct lpr_fit *out)
+{
+	const int nch = img->nch;
+	double t[2 * LPR_MAXRADIUS + 1];
+	kernel_weights(r, t);
+	int x0 = x - r < 0 ? 0 : x - r, x1 = x + r >= img->w ? img->w - 1 : x + r;
+	int y0 = y - r < 0 ? 0 : y - r, y1 = y + r >= img->h ? img->h - 1 : y + r;
+
+	struct design d = { .r = r };
+	design_features(&d, img, feat, x, y, x0, x1, y0, y1, t);
+	const int p = NSP + d.nf;
+
+	/* Normal equations without the centre sample. */
+	struct lpr_system sys;
+	memset(&sys, 0, sizeof sys);
+	sys.nf = d.nf;
+	sys.nch = nch;
+	double xr[WLS_MAXP];
+	unmasked = unmasked && !feat;
+	if (unmasked) {
+		unmasked_system(img, x, y, r, t, x0, x1, y0, y1, sys.a, sys.b, sys.bq);
+		sys.have_bq = 1;
+		sys.n = (x1 - x0 + 1) * (y1 - y0 + 1) - 1;
+		sys.sw = sys.a[0];
+	} else {
+		for (int yy = y0; yy <= y1; yy++)
+			for (int xx = x0; xx <= x1; xx++) {
+				size_t idx = (size_t)yy * img->w + xx;
+				if ((xx == x && yy == y) || !lpr_sample_valid(img, feat, idx))
+					continue;
+				double w = t[xx - x + r] * t[yy - y + r];
+				design_row(&d, feat, idx, xx - x, yy - y, xr);
+				for (int k = 0; k < p; k++) {
+					double wx = w * xr[k];
+					for (int m = k; m < p; m++)
+						sys.a[k * p + m] += wx * xr[m];
+				}
+				const float *yv = img->px + idx * (size_t)nch;
+				for (int c = 0; c < nch; c++)
+					for (int k = 0; k < p; k++)
+						sys.b[c][k] += w * xr[k] * yv[c];
+				sys.sw += w;
+				sys.n++;
+			}
+		for (int k = 0; k < p; k++)
+			for (int m = 0; m < k; m++)
+				sys.a[k * p + m] = sys.a[m * p + k];
+	}
+
+	size_t cidx = (size_t)y * img->w + x;
+	int hole = !lpr_sample_valid(img, NULL, cidx);
+	const float *yc = img->px + cidx * (size_t)nch;
+	struct lpr_solution sol;
+	lpr_system_solve(&sys, maxorder, hole, out, &sol);
+
+	/* Without B', a second pass over the window gives the variance of the
+	 * leave-one-out prediction and, for a hole, the residuals of the fit. */
+	if (!sys.have_bq)
+		for (int yy = y0; yy <= y1; yy++)
+			for (int xx = x0; xx <= x1; xx++) {
+				size_t idx = (size_t)yy * img->w + xx;
+				if ((xx == x && yy == y) || !lpr_sample_valid(img, feat, idx))
+					continue;
+				double w = t[xx - x + r] * t[yy - y + r];
+				design_row(&d, feat, idx, xx - x, yy - y, xr);
+				const float *yv = img->px + idx * (size_t)nch;
+				for (int o = 0; o <= maxorder; o++) {
+					if (!out[o].valid)
+						continue;
+					double sz = 0.0;
+					for (int k = 0; k < p; k++)
+						sz += xr[k] * sol.z[o][k];
+					sol.vsum[o] += (w * sz) * (w * sz);
+					if (!hole)
+						continue;
+					for (int c = 0; c < nch; c++) {
+						double fv = 0.0;
+						for (int k = 0; k < p; k++)
+							fv += xr[k] * sol.beta[o][c][k];
+						double res = yv[c] - fv;
+						sol.rss[o][c] += w * res * res;
+					}
+				}
+			}
+	lpr_system_finish(&sys, yc, hole, r, maxorder, &sol, out);
 }
 
 int lpr_fit_pixel(const struct lpr_image *img, const struct lpr_image *features,

@@ -17,6 +17,7 @@ int wls_factor(const double *a, int p, const int *act, int nact, struct wls_fact
 	for (int k = 0; k < nact; k++) {
 		int ck = act[k];
 		f->kept[k] = 0;
+		f->inv[k] = 0.0;
 		for (int i = 0; i < nact; i++)
 			l[i * nact + k] = 0.0;
 		if (f->scale[k] == 0.0)
@@ -30,6 +31,7 @@ int wls_factor(const double *a, int p, const int *act, int nact, struct wls_fact
 			continue;
 		double lkk = sqrt(d);
 		l[k * nact + k] = lkk;
+		f->inv[k] = 1.0 / lkk;
 		f->kept[k] = 1;
 		f->rank++;
 		for (int i = k + 1; i < nact; i++) {
@@ -45,36 +47,48 @@ int wls_factor(const double *a, int p, const int *act, int nact, struct wls_fact
 	return f->rank;
 }
 
-void wls_solve(const struct wls_factor *f, const double *b, double *x)
+void wls_solve_n(const struct wls_factor *f, int nrhs, const double *b, double *x, int ld)
 {
-	int n = f->nact;
+	const int n = f->nact, p = f->p;
 	const double *l = f->l;
-	double y[WLS_MAXP];
+	double y[WLS_MAXP][WLS_NRHS];
 
+	/* Dropped columns have a zero column in l and inv = 0, so they come
+	 * out as 0 without a test.  The right-hand sides run in the inner
+	 * loops: independent sums that the processor overlaps. */
 	for (int k = 0; k < n; k++) {
-		if (!f->kept[k]) {
-			y[k] = 0.0;
-			continue;
+		const int ck = f->act[k];
+		for (int j = 0; j < nrhs; j++)
+			y[k][j] = b[j * ld + ck] * f->scale[k];
+		for (int m = 0; m < k; m++) {
+			const double lkm = l[k * n + m];
+			for (int j = 0; j < nrhs; j++)
+				y[k][j] -= lkm * y[m][j];
 		}
-		double s = b[f->act[k]] * f->scale[k];
-		for (int m = 0; m < k; m++)
-			s -= l[k * n + m] * y[m];
-		y[k] = s / l[k * n + k];
+		for (int j = 0; j < nrhs; j++)
+			y[k][j] *= f->inv[k];
 	}
 	for (int k = n - 1; k >= 0; k--) {
-		if (!f->kept[k]) {
-			y[k] = 0.0;
-			continue;
+		for (int m = k + 1; m < n; m++) {
+			const double lmk = l[m * n + k];
+			for (int j = 0; j < nrhs; j++)
+				y[k][j] -= lmk * y[m][j];
 		}
-		double s = y[k];
-		for (int m = k + 1; m < n; m++)
-			s -= l[m * n + k] * y[m];
-		y[k] = s / l[k * n + k];
+		for (int j = 0; j < nrhs; j++)
+			y[k][j] *= f->inv[k];
 	}
-	for (int i = 0; i < f->p; i++)
-		x[i] = 0.0;
-	for (int k = 0; k < n; k++)
-		x[f->act[k]] = y[k] * f->scale[k];
+	for (int j = 0; j < nrhs; j++) {
+		double *xj = x + j * ld;
+		for (int i = 0; i < p; i++)
+			xj[i] = 0.0;
+		for (int k = 0; k < n; k++)
+			xj[f->act[k]] = y[k][j] * f->scale[k];
+	}
+}
+
+void wls_solve(const struct wls_factor *f, const double *b, double *x)
+{
+	wls_solve_n(f, 1, b, x, f->p);
 }
 
 int wls_kept(const struct wls_factor *f, int col)

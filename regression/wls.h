@@ -14,6 +14,7 @@
 
 #define WLS_MAXP 16
 #define WLS_PIVOT_TOL 1e-9
+#define WLS_NRHS 17
 
 struct wls_factor {
 	int p;                          /* size of the full system */
@@ -23,6 +24,7 @@ struct wls_factor {
 	int rank;                       /* number of kept columns */
 	double scale[WLS_MAXP];         /* equilibration, per active column */
 	double l[WLS_MAXP * WLS_MAXP];  /* Cholesky factor, nact x nact */
+	double inv[WLS_MAXP];           /* 1 / diagonal of l; 0 for dropped columns */
 };
 
 /*
@@ -37,6 +39,13 @@ int wls_factor(const double *a, int p, const int *act, int nact, struct wls_fact
  * only its active entries are read.
  */
 void wls_solve(const struct wls_factor *f, const double *b, double *x);
+
+/*
+ * Solve for nrhs <= WLS_NRHS right-hand sides at once: right-hand side j
+ * is b[j * ld .. j * ld + p - 1], and its solution goes to x[j * ld ..]
+ * (ld >= p).
+ */
+void wls_solve_n(const struct wls_factor *f, int nrhs, const double *b, double *x, int ld);
 
 /* 1 when column col is active and kept, else 0. */
 int wls_kept(const struct wls_factor *f, int col);
