@@ -4,7 +4,7 @@
 # high-quality render of the same scene.
 #
 # usage: scripts/demo.sh [BUILD_DIR] [SCENE.pov] [WIDTH HEIGHT]
-# Writes everything to BUILD_DIR/demo/: base.exr (the render), analysis.exr,
+# Writes everything to BUILD_DIR/demo/ (or $DEMO_OUT): base.exr (the render), analysis.exr,
 # ref.exr (the reference), and PNG previews of the render, the
 # reconstruction, the error maps (without and with the +Q1 feature pass)
 # and the order map.
@@ -15,7 +15,7 @@ ROOT=$(cd "$(dirname "$0")/.." && pwd)
 SCENE=${2:-$ROOT/scenes/soft_shadows.pov}
 W=${3:-320}
 H=${4:-240}
-OUT="$BUILD/demo"
+OUT="${DEMO_OUT:-$BUILD/demo}"
 mkdir -p "$OUT"
 
 render() { # OUTPUT [POV-Ray options...]
