@@ -173,7 +173,7 @@ long lpr_fast_strip(const struct lpr_filters *f, const float *clean, int w, int 
 			const unsigned char *el = elig + (size_t)(y - ya) * w;
 			int any = 0;
 			for (int x = tx; x < tx1 && !any; x++)
-				any = el[x] == 1;
+				any = el[x] == LPR_WIN_INTERIOR;
 			if (!any)
 				continue;
 			double *a00 = acc, *a20 = acc + rowlen, *a02 = acc + 2 * rowlen;
@@ -204,7 +204,7 @@ long lpr_fast_strip(const struct lpr_filters *f, const float *clean, int w, int 
 			size_t base = (size_t)(y - ya) * w;
 			const float *in = clean + (size_t)y * rowlen;
 			for (int x = tx; x < tx1; x++) {
-				if (el[x] != 1)
+				if (el[x] != LPR_WIN_INTERIOR)
 					continue;
 				double fit0[LPR_MAXCH], fit2[LPR_MAXCH], dx[LPR_MAXCH], dy[LPR_MAXCH];
 				double p0 = 0.0, p2 = 0.0;

@@ -200,7 +200,7 @@ long lpr_feat_strip(const struct lpr_filters *f, const struct lpr_image *img,
 		const unsigned char *el = elig + (size_t)(y - ya) * w;
 		int any = 0;
 		for (int x = 0; x < w && !any; x++)
-			any = el[x] != 0;
+			any = el[x] != LPR_WIN_MASKED;
 		if (!any)
 			continue;
 		int jlo = y - r < 0 ? -y : -r, jhi = y + r >= h ? h - 1 - y : r;
@@ -238,7 +238,7 @@ long lpr_feat_strip(const struct lpr_filters *f, const struct lpr_image *img,
 		/* Per pixel: assemble the normal equations and solve. */
 		for (int x = 0; x < w; x++) {
 			size_t li = (size_t)(y - ya) * w + x;
-			if (!el[x])
+			if (el[x] == LPR_WIN_MASKED)
 				continue;
 			size_t gi = (size_t)y * w + x;
 			const float *yc = img->px + gi * nch;

@@ -7,6 +7,13 @@
 
 #define LPR_NORDERS 3
 
+/* A pixel's window of some radius, as the strip code classifies it. */
+enum {
+	LPR_WIN_MASKED,    /* holds a missing sample (or a missing feature) */
+	LPR_WIN_INTERIOR,  /* inside the image, complete */
+	LPR_WIN_CLIPPED,   /* clipped by the border, otherwise complete */
+};
+
 /* Number of spatial columns of a polynomial of the given order. */
 static inline int lpr_nspatial(int order)
 {
@@ -96,8 +103,8 @@ void lpr_cand_write(struct lpr_cand_buf *b, size_t i, int nch, const struct lpr_
 size_t lpr_fast_scratch(int w, int nch, int nrows, int r);
 
 /*
- * Fit every pixel of rows [ya, yb) whose elig flag is 1 (elig is indexed
- * from row ya), from clean (the image with holes replaced by 0), writing
+ * Fit every pixel of rows [ya, yb) whose elig flag is LPR_WIN_INTERIOR (elig
+ * is indexed from row ya), from clean (the image with holes replaced by 0), writing
  * the order-0, -1 and -2 candidates into c[0..2] (an entry may be NULL).
  * The order-1 fit equals the order-0 fit on these pixels: only its e2, q
  * and lev are written, and its first fit value is set to NaN to say so.
@@ -112,7 +119,7 @@ size_t lpr_feat_scratch(int w, int nch, int nf, int nrows, int r);
 
 /*
  * Fit, with the features of feat, every pixel of rows [ya, yb) whose elig
- * flag is non-zero (its window holds no missing sample), for orders
+ * flag is not LPR_WIN_MASKED (its window holds no missing sample), for orders
  * 0 .. maxorder, writing c[0..2] (an entry may be NULL).  Returns the
  * number of pixels fitted.
  */

@@ -130,39 +130,42 @@ static void fit_radius(struct worker *wk, int ri, int ya, int yb)
 	struct shared *sh = wk->sh;
 	const struct lpr_image *img = sh->img;
 	const int w = img->w, h = img->h, nch = img->nch;
-	const int use_fast = !sh->feat && !sh->p->force_general;
 	const struct lpr_filters *f = &sh->filt[ri];
 	const int r = f->r;
 	struct lpr_cand_buf *cb[LPR_NORDERS];
 	for (int o = 0; o < LPR_NORDERS; o++)
 		cb[o] = o >= sh->omin && o <= sh->omax ? &wk->buf[o] : NULL;
 
-	/* elig: 1 fast path, 2 clipped but unmasked, 0 general. */
 	for (int y = ya; y < yb; y++)
 		for (int x = 0; x < w; x++) {
 			int x0 = x - r < 0 ? 0 : x - r, x1 = x + r >= w ? w - 1 : x + r;
 			int y0 = y - r < 0 ? 0 : y - r, y1 = y + r >= h ? h - 1 : y + r;
-			int clean = !invalid_in(sh, x0, y0, x1, y1);
 			int inside = x0 == x - r && x1 == x + r && y0 == y - r && y1 == y + r;
-			unsigned char e = clean ? (inside && use_fast ? 1 : 2) : 0;
-			wk->elig[(size_t)(y - ya) * w + x] = e;
+			wk->elig[(size_t)(y - ya) * w + x] =
+				invalid_in(sh, x0, y0, x1, y1) ? LPR_WIN_MASKED :
+				inside ? LPR_WIN_INTERIOR : LPR_WIN_CLIPPED;
 		}
-	if (use_fast)
+
+	/* Who fits what: without features the fast path takes the interior
+	 * windows; with features the moment path takes every unmasked one;
+	 * the general path takes the rest (all, when forced). */
+	const int maxo = sh->omax < 1 ? 1 : sh->omax;
+	const int force = sh->p->force_general;
+	if (!force && !sh->feat)
 		wk->fast += lpr_fast_strip(f, sh->clean, w, h, nch, ya, yb, wk->elig,
 					   wk->fscratch, cb);
-	int use_feat = sh->feat && !sh->p->force_general;
-	if (use_feat)
+	if (!force && sh->feat)
 		wk->fast += lpr_feat_strip(f, img, sh->clean, sh->feat, ya, yb, wk->elig,
-					   wk->fscratch, cb, sh->omax < 1 ? 1 : sh->omax);
-	int maxo = sh->omax < 1 ? 1 : sh->omax;
+					   wk->fscratch, cb, maxo);
 	for (int y = ya; y < yb; y++)
 		for (int x = 0; x < w; x++) {
 			size_t i = (size_t)(y - ya) * w + x;
-			if (wk->elig[i] == 1 || (use_feat && wk->elig[i]))
+			int e = wk->elig[i];
+			if (!force && (sh->feat ? e != LPR_WIN_MASKED : e == LPR_WIN_INTERIOR))
 				continue;
 			struct lpr_fit fits[LPR_NORDERS];
 			lpr_general_fits(img, sh->feat, x, y, r, maxo,
-					 wk->elig[i] == 2 && !sh->p->force_general, fits);
+					 !force && e == LPR_WIN_CLIPPED, fits);
 			for (int o = 0; o < LPR_NORDERS; o++)
 				if (cb[o])
 					lpr_cand_write(cb[o], i, nch, &fits[o]);
