@@ -15,7 +15,7 @@
 
 static const char usage[] =
 	"usage: povpress analyze IN.exr -o OUT.exr [--features F.exr] [--order auto|0|1|2]\n"
-	"                        [--radius auto|R] [--threads N] [-v]\n"
+	"                        [--radius auto|R] [--radii R1,R2,...] [--threads N] [-v]\n"
 	"\n"
 	"Fit a local polynomial regression at every pixel of IN.exr (RGB or RGBA,\n"
 	"half or float, scanline or tiled; NaN/Inf pixels are holes), choose the\n"
@@ -33,7 +33,9 @@ static const char usage[] =
 	"  --features FILE     noise-free feature image of the same size (e.g. a POV-Ray\n"
 	"                      +Q1 render); its R, G, B (or all channels) become predictors\n"
 	"  --order auto|N      fix the polynomial order (default auto)\n"
-	"  --radius auto|R     fix the kernel radius, 1..32 (default auto: 2, 3, 5, 8)\n"
+	"  --radius auto|R     fix the kernel radius, 1..32 (default auto)\n"
+	"  --radii LIST        the radii auto chooses among, comma-separated, at most 8\n"
+	"                      (default 2,3,5,8; fewer and smaller radii are faster)\n"
 	"  --threads N         worker threads (default: one per core)\n"
 	"  -v, --verbose       print timing and summary figures to stderr\n"
 	"  -h, --help          this text\n";
@@ -46,6 +48,26 @@ static int parse_int(const char *s, int lo, int hi, int *out)
 	if (errno || end == s || *end || v < lo || v > hi)
 		return -1;
 	*out = (int)v;
+	return 0;
+}
+
+/* "2,5,8" -> p->radii; -1 on anything else. */
+static int parse_radii(const char *s, struct lpr_params *p)
+{
+	char buf[128];
+	if (strlen(s) >= sizeof buf)
+		return -1;
+	strcpy(buf, s);
+	int n = 0;
+	for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok;
+	     tok = strtok_r(NULL, ",", &save)) {
+		if (n == 8 || parse_int(tok, 1, LPR_MAXRADIUS, &p->radii[n]))
+			return -1;
+		n++;
+	}
+	if (!n)
+		return -1;
+	p->nradii = n;
 	return 0;
 }
 
@@ -144,6 +166,13 @@ int cmd_analyze(int argc, char **argv)
 			else if (parse_int(v, 1, LPR_MAXRADIUS, &p.radius)) {
 				fprintf(stderr, "povpress analyze: bad --radius '%s' (auto or 1..%d)\n", v,
 					LPR_MAXRADIUS);
+				return 2;
+			}
+		} else if (!strcmp(a, "--radii") && more) {
+			const char *v = argv[++i];
+			if (parse_radii(v, &p)) {
+				fprintf(stderr, "povpress analyze: bad --radii '%s' (1 to 8 radii in 1..%d, "
+					"comma-separated)\n", v, LPR_MAXRADIUS);
 				return 2;
 			}
 		} else if (!strcmp(a, "--threads") && more) {

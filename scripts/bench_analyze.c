@@ -100,6 +100,12 @@ int main(int argc, char **argv)
 		printf("%-22s %9.3f %9.2f\n", names[o + 1], t, mp / t);
 	}
 	lpr_params_init(&p);
+	p.nradii = 2;
+	p.radii[0] = 2;
+	p.radii[1] = 5;
+	double t25 = best_time(&img, &p, reps);
+	printf("%-22s %9.3f %9.2f\n", "--radii 2,5", t25, mp / t25);
+	lpr_params_init(&p);
 	p.nthreads = 1;
 	double t1 = best_time(&img, &p, reps);
 	printf("%-22s %9.3f %9.2f\n", "default, 1 thread", t1, mp / t1);

@@ -147,6 +147,19 @@ check "texture+features: mean error within 50% of sigma^2 ($ef vs 0.0004)" num '
 check "texture+features: reconstruction MSE <= sigma^2/2 ($m)" num 'a <= 0.0002' "$m"
 check "texture without features: error >= 5x higher ($en vs $ef)" num 'a >= 5 * b' "$en" "$ef"
 
+# --- fixed order and radius ------------------------------------------------------
+"$PP" analyze "$T/noise.exr" --order 2 --radius 4 -o "$T/o2r4.exr"
+check "--order 2 --radius 4: every pixel has order 2 and bandwidth 4" \
+	num 'a == 2 && b == 2 && c == 4' "$(chstat "$T/o2r4.exr" order Min)" \
+	"$(chstat "$T/o2r4.exr" order Max)" "$(chstat "$T/o2r4.exr" bandwidth Min)"
+check "--radius 4: bandwidth max 4" num 'a == 4' "$(chstat "$T/o2r4.exr" bandwidth Max)"
+"$PP" analyze "$T/noise.exr" --radii 3,6 -o "$T/r36.exr"
+lo=$(chstat "$T/r36.exr" bandwidth Min)
+hi=$(chstat "$T/r36.exr" bandwidth Max)
+check "--radii 3,6: bandwidths within 3..6 ($lo..$hi)" num 'a >= 3 && b <= 6' "$lo" "$hi"
+"$PP" analyze "$T/noise.exr" --radii 3,x -o "$T/bad.exr" 2>/dev/null
+check "bad --radii is a usage error (2)" test $? -eq 2
+
 # --- threads -----------------------------------------------------------------
 "$PP" analyze "$T/holes.exr" --threads 1 -o "$T/t1.exr"
 "$PP" analyze "$T/holes.exr" --threads 2 -o "$T/t2.exr"
