@@ -226,6 +226,18 @@ povray -D -GA +W96 +H72 +FE +WT1 Declare=AreaN=12 "+O$T/ref.exr" "+I$T/scene.pov
 out=$("$PP" compare "$T/render.exr" "$T/ref.exr")
 check "render: compare against a 12x12-light render" num 'a > 0' "$(cmpval "$out" relmse)"
 
+# --- every bundled scene renders and analyses -------------------------------------
+for scene in "$ROOT"/scenes/*.pov; do
+	name=$(basename "$scene" .pov)
+	if povray -D -GA +W80 +H60 +FE +WT1 "+O$T/s_$name.exr" "+I$scene" "+L$ROOT/scenes" \
+		>"$T/s_$name.log" 2>&1 && "$PP" analyze "$T/s_$name.exr" -o "$T/s_$name.a.exr"; then
+		nan=$(oiiotool "$T/s_$name.a.exr" --printstats 2>/dev/null | awk '$2 == "NanCount:" || $2 == "InfCount:" { for (i = 3; i <= NF; i++) s += $i } END { print s + 0 }')
+		check "scenes/$name.pov renders and analyses to finite values" test "$nan" -eq 0
+	else
+		bad "scenes/$name.pov renders and analyses ($(tail -3 "$T/s_$name.log" | tr '\n' ' '))"
+	fi
+done
+
 echo
 echo "$passed passed, $failed failed"
 test "$failed" -eq 0
