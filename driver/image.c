@@ -18,6 +18,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -605,48 +606,136 @@ static int aim_encoder(exr_encode_pipeline_t *enc, const struct image *img, int 
 	return 0;
 }
 
+/*
+ * Chunks are compressed by several threads at once, each with its own
+ * encode pipeline, and kept in memory; the file is then written in chunk
+ * order by the calling thread.  OpenEXRCore leaves the scheduling of
+ * multi-threaded writes to the caller (yield_until_ready_fn, write_fn): a
+ * pipeline here never writes, it hands its compressed bytes to stash_chunk.
+ */
+struct chunk_data {
+	void *data;
+	size_t size;
+};
+
+struct encoder {
+	exr_context_t ctx;
+	const struct image *img;
+	int lpc, nchunks, next;
+	struct chunk_data *chunks;
+	exr_result_t rv;
+	pthread_mutex_t lock;
+};
+
+static exr_result_t ready_now(exr_encode_pipeline_t *enc)
+{
+	(void)enc;
+	return EXR_ERR_SUCCESS;
+}
+
+static exr_result_t stash_chunk(exr_encode_pipeline_t *enc)
+{
+	struct chunk_data *cd = enc->encoding_user_data;
+	cd->data = malloc(enc->compressed_bytes ? enc->compressed_bytes : 1);
+	if (!cd->data)
+		return EXR_ERR_OUT_OF_MEMORY;
+	memcpy(cd->data, enc->compressed_buffer, enc->compressed_bytes);
+	cd->size = enc->compressed_bytes;
+	return EXR_ERR_SUCCESS;
+}
+
+static void *encode_chunks(void *arg)
+{
+	struct encoder *e = arg;
+	exr_encode_pipeline_t enc;
+	int started = 0;
+	exr_result_t rv = EXR_ERR_SUCCESS;
+
+	memset(&enc, 0, sizeof(enc));
+	for (;;) {
+		pthread_mutex_lock(&e->lock);
+		int i = e->rv == EXR_ERR_SUCCESS ? e->next++ : e->nchunks;
+		pthread_mutex_unlock(&e->lock);
+		if (i >= e->nchunks)
+			break;
+		int y = i * e->lpc;
+		exr_chunk_info_t ci;
+		rv = exr_write_scanline_chunk_info(e->ctx, 0, y, &ci);
+		if (rv == EXR_ERR_SUCCESS && !started) {
+			rv = exr_encoding_initialize(e->ctx, 0, &ci, &enc);
+			started = rv == EXR_ERR_SUCCESS;
+			if (started && aim_encoder(&enc, e->img, y))
+				rv = EXR_ERR_INVALID_ARGUMENT;
+			else if (started)
+				rv = exr_encoding_choose_default_routines(e->ctx, 0, &enc);
+		} else if (rv == EXR_ERR_SUCCESS) {
+			rv = exr_encoding_update(e->ctx, 0, &ci, &enc);
+			if (rv == EXR_ERR_SUCCESS && aim_encoder(&enc, e->img, y))
+				rv = EXR_ERR_INVALID_ARGUMENT;
+		}
+		if (rv == EXR_ERR_SUCCESS) {
+			enc.yield_until_ready_fn = ready_now;
+			enc.write_fn = stash_chunk;
+			enc.encoding_user_data = &e->chunks[i];
+			rv = exr_encoding_run(e->ctx, 0, &enc);
+		}
+		if (rv != EXR_ERR_SUCCESS) {
+			pthread_mutex_lock(&e->lock);
+			if (e->rv == EXR_ERR_SUCCESS)
+				e->rv = rv;
+			pthread_mutex_unlock(&e->lock);
+			break;
+		}
+	}
+	if (started)
+		exr_encoding_destroy(e->ctx, &enc);
+	return NULL;
+}
+
 /* Encode all of img into the context, whose header is complete but unwritten. */
 static exr_result_t encode_image(exr_context_t ctx, const struct image *img)
 {
-	exr_encode_pipeline_t enc;
-	exr_chunk_info_t ci;
-	int32_t lpc = 0;
-	int started = 0;
-	exr_result_t rv;
-
-	memset(&enc, 0, sizeof(enc));
-	rv = exr_write_header(ctx);
+	struct encoder e = { .ctx = ctx, .img = img };
+	exr_result_t rv = exr_write_header(ctx);
 	if (rv == EXR_ERR_SUCCESS)
-		rv = exr_get_scanlines_per_chunk(ctx, 0, &lpc);
-	if (rv == EXR_ERR_SUCCESS && lpc <= 0)
+		rv = exr_get_scanlines_per_chunk(ctx, 0, &e.lpc);
+	if (rv == EXR_ERR_SUCCESS && e.lpc <= 0)
 		rv = EXR_ERR_INVALID_ATTR;
-	for (int y = 0; rv == EXR_ERR_SUCCESS && y < img->h; y += lpc) {
-		rv = exr_write_scanline_chunk_info(ctx, 0, y, &ci);
-		if (rv != EXR_ERR_SUCCESS)
+	if (rv != EXR_ERR_SUCCESS)
+		return rv;
+	e.nchunks = (img->h + e.lpc - 1) / e.lpc;
+	e.chunks = calloc((size_t)e.nchunks, sizeof *e.chunks);
+	if (!e.chunks)
+		return EXR_ERR_OUT_OF_MEMORY;
+	pthread_mutex_init(&e.lock, NULL);
+
+	long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+	int nth = ncpu < 1 ? 1 : ncpu > 16 ? 16 : (int)ncpu;
+	if (nth > e.nchunks)
+		nth = e.nchunks;
+	pthread_t tid[16];
+	int started = 0;
+	for (; started < nth - 1; started++)
+		if (pthread_create(&tid[started], NULL, encode_chunks, &e))
 			break;
-		if (!started) {
-			rv = exr_encoding_initialize(ctx, 0, &ci, &enc);
-			if (rv != EXR_ERR_SUCCESS)
-				break;
-			started = 1;
-			if (aim_encoder(&enc, img, y))
-				rv = EXR_ERR_INVALID_ARGUMENT;
-			else
-				rv = exr_encoding_choose_default_routines(ctx, 0, &enc);
-		} else {
-			rv = exr_encoding_update(ctx, 0, &ci, &enc);
-			if (rv == EXR_ERR_SUCCESS && aim_encoder(&enc, img, y))
-				rv = EXR_ERR_INVALID_ARGUMENT;
-		}
+	encode_chunks(&e);   /* the calling thread works too */
+	for (int i = 0; i < started; i++)
+		pthread_join(tid[i], NULL);
+	rv = e.rv;
+
+	for (int i = 0; i < e.nchunks; i++) {
 		if (rv == EXR_ERR_SUCCESS)
-			rv = exr_encoding_run(ctx, 0, &enc);
+			rv = e.chunks[i].data ?
+				exr_write_scanline_chunk(ctx, 0, i * e.lpc, e.chunks[i].data,
+							 e.chunks[i].size) :
+				EXR_ERR_INVALID_ARGUMENT;
+		free(e.chunks[i].data);
 	}
-	if (started)
-		exr_encoding_destroy(ctx, &enc);
+	free(e.chunks);
+	pthread_mutex_destroy(&e.lock);
 	return rv;
 }
 
-/* Write img into the open descriptor fd; path only names the file in errors. */
 static int write_fd(int fd, const char *path, const struct image *img, exr_pixel_type_t type,
 		    char *err, size_t errlen)
 {
