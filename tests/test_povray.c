@@ -1,0 +1,1362 @@
+/*
+ * test_povray.c - unit tests for driver/povray.c (the POV-Ray runner).
+ *
+ * Argument vectors, shell lines and statistics are checked without
+ * POV-Ray, the statistics against output captured from povray 3.7.0.10
+ * (tests/data/povray/).  The pool is checked with a fake "povray" shell
+ * script where only the runner's behaviour matters (concurrency, crashes,
+ * error extraction), and with the real povray where POV-Ray's matters
+ * (paths with spaces and quotes, regions, parse errors, timeouts, signals).
+ * A missing povray fails the tests rather than skipping them.
+ *
+ * Files go in a fresh mkdtemp() directory whose own name has a space.
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <errno.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "driver/image.h"
+#include "driver/povray.h"
+
+#define DATA "tests/data/povray/"
+
+static char scratch_dir[96];
+static char fake_bin[PATH_MAX];
+
+static const char *scratch(char *buf, size_t len, const char *name)
+{
+	int n = snprintf(buf, len, "%s/%s", scratch_dir, name);
+
+	assert_true(n > 0 && (size_t)n < len);
+	return buf;
+}
+
+/* Run a shell command; its exit status, or -1 if it did not exit. */
+static int run(const char *fmt, ...)
+{
+	char cmd[4096];
+	va_list ap;
+	int n, st;
+
+	va_start(ap, fmt);
+	n = vsnprintf(cmd, sizeof(cmd), fmt, ap);
+	va_end(ap);
+	assert_true(n > 0 && (size_t)n < sizeof(cmd));
+	st = system(cmd);
+	if (st == -1 || !WIFEXITED(st))
+		return -1;
+	return WEXITSTATUS(st);
+}
+
+static void write_file(const char *path, const char *text)
+{
+	FILE *f = fopen(path, "w");
+
+	if (!f)
+		fail_msg("cannot write '%s': %s", path, strerror(errno));
+	fputs(text, f);
+	fclose(f);
+}
+
+/* A malloc'd copy of a whole file, or NULL. */
+static char *read_file(const char *path)
+{
+	FILE *f = fopen(path, "rb");
+	char *s;
+	long n;
+
+	if (!f)
+		return NULL;
+	fseek(f, 0, SEEK_END);
+	n = ftell(f);
+	fseek(f, 0, SEEK_SET);
+	s = malloc((size_t)n + 1);
+	assert_non_null(s);
+	assert_int_equal(fread(s, 1, (size_t)n, f), (size_t)n);
+	s[n] = '\0';
+	fclose(f);
+	return s;
+}
+
+static int exists(const char *path)
+{
+	struct stat st;
+
+	return lstat(path, &st) == 0;
+}
+
+/* Run line with /bin/sh -c, output discarded; its exit status or -1. */
+static int sh_c(const char *line)
+{
+	pid_t pid;
+	int st;
+
+	fflush(NULL);
+	pid = fork();
+	assert_true(pid >= 0);
+	if (pid == 0) {
+		if (!freopen("/dev/null", "w", stdout) || !freopen("/dev/null", "w", stderr))
+			_exit(126);
+		execl("/bin/sh", "sh", "-c", line, (char *)NULL);
+		_exit(127);
+	}
+	assert_int_equal(waitpid(pid, &st, 0), pid);
+	return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* Entries of dir whose name contains part. */
+static int count_entries(const char *dir, const char *part)
+{
+	DIR *d = opendir(dir);
+	struct dirent *e;
+	int n = 0;
+
+	assert_non_null(d);
+	while ((e = readdir(d)))
+		n += strstr(e->d_name, part) != NULL;
+	closedir(d);
+	return n;
+}
+
+static void pause_s(double s)
+{
+	struct timespec ts = { (time_t)s, (long)((s - (double)(time_t)s) * 1e9) };
+
+	while (nanosleep(&ts, &ts) && errno == EINTR)
+		;
+}
+
+static double now_s(void)
+{
+	struct timespec ts;
+
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void mkdir_p(const char *path)
+{
+	if (mkdir(path, 0755) && errno != EEXIST)
+		fail_msg("cannot make '%s': %s", path, strerror(errno));
+}
+
+/* Live processes whose command line contains tag (letters, digits, '-'). */
+static int count_procs(const char *tag)
+{
+	char cmd[256], line[64];
+	FILE *p;
+	int n = 0;
+
+	/* "[x]rest" matches tag but not the shell running pgrep. */
+	snprintf(cmd, sizeof(cmd), "pgrep -c -f -- '[%c]%s'", tag[0], tag + 1);
+	p = popen(cmd, "r");
+	assert_non_null(p);
+	if (fgets(line, sizeof(line), p))
+		n = atoi(line);
+	pclose(p);
+	return n;
+}
+
+/* Wait up to timeout_s until count_procs(tag) == want; returns the count. */
+static int wait_procs(const char *tag, int want, double timeout_s)
+{
+	double end = now_s() + timeout_s;
+	int n;
+
+	while ((n = count_procs(tag)) != want && now_s() < end)
+		pause_s(0.05);
+	return n;
+}
+
+static const char tiny_scene[] =
+	"#version 3.7;\n"
+	"global_settings { assumed_gamma 1.0 }\n"
+	"#include \"tiny_colours.inc\"\n"
+	"background { color rgb <0.2, 0.3, 0.4> }\n"
+	"camera { location <0, 0, -3> look_at 0 }\n"
+	"light_source { <2, 4, -3> color rgb 1 }\n"
+	"sphere { 0, 1 pigment { color Tiny_Colour } }\n";
+
+/* The scene, with its include beside it, in dir; returns the scene path. */
+static const char *make_tiny_scene(char *path, size_t len, const char *dir, const char *name)
+{
+	char inc[PATH_MAX];
+
+	mkdir_p(dir);
+	snprintf(inc, sizeof(inc), "%s/tiny_colours.inc", dir);
+	write_file(inc, "#declare Tiny_Colour = rgb <1, 0.5, 0.2>;\n");
+	snprintf(path, len, "%s/%s", dir, name);
+	write_file(path, tiny_scene);
+	return path;
+}
+
+/* A scene that takes well over 10 s at 640x480 with +AM2 +A0 +R4. */
+static const char slow_scene[] =
+	"#version 3.7;\n"
+	"global_settings { assumed_gamma 1.0 }\n"
+	"camera { location <0, 2, -6> look_at 0 focal_point 0 aperture 0.5 blur_samples 100 }\n"
+	"light_source { <2, 4, -3> color rgb 1 area_light x, z, 16, 16 jitter adaptive 0 }\n"
+	"#for (i, 0, 40)\n"
+	"  sphere { <mod(i, 7) - 3, 0, div(i, 7) - 2>, 0.4\n"
+	"    pigment { color rgb <1, 0.5, 0.2> } finish { reflection 0.3 } }\n"
+	"#end\n"
+	"plane { y, -0.5 pigment { checker } }\n";
+
+static const char *const slow_extra[] = { "+AM2", "+A0.0", "+R4" };
+
+static void slow_job(struct pov_job *job, const char *scene, const char *out)
+{
+	memset(job, 0, sizeof(*job));
+	job->scene = scene;
+	job->output = out;
+	job->width = 640;
+	job->height = 480;
+	job->threads = 1;
+	job->extra = slow_extra;
+	job->nextra = 3;
+}
+
+/*
+ * A stand-in for povray, steered by $FAKE_MODE:
+ *   args     write its arguments, NUL-terminated, to $FAKE_ARGS; make the output
+ *   sleep    append "start end" wall times to $FAKE_LOG around a 0.3 s sleep
+ *   fixture  copy $FAKE_FIXTURE to stderr and exit 1
+ *   segv     kill itself with SIGSEGV
+ *   noout    exit 0 without writing anything
+ */
+static const char fake_script[] =
+	"#!/bin/sh\n"
+	"out=\n"
+	"for a in \"$@\"; do\n"
+	"  case \"$a\" in +O*) out=${a#+O}; out=${out#\\\"}; out=${out%\\\"};; esac\n"
+	"done\n"
+	"case \"$FAKE_MODE\" in\n"
+	"args) for a in \"$@\"; do printf '%s\\0' \"$a\"; done > \"$FAKE_ARGS\"; : > \"$out\";;\n"
+	"sleep) s=$(date +%s.%N); sleep 0.3; e=$(date +%s.%N); echo \"$s $e\" >> \"$FAKE_LOG\";"
+	" : > \"$out\";;\n"
+	"fixture) cat \"$FAKE_FIXTURE\" >&2; exit 1;;\n"
+	"segv) kill -SEGV $$;;\n"
+	"noout) exit 0;;\n"
+	"*) exit 3;;\n"
+	"esac\n";
+
+static int setup_dir(void **state)
+{
+	(void)state;
+	snprintf(scratch_dir, sizeof(scratch_dir), "/tmp/povpress test povray.XXXXXX");
+	if (!mkdtemp(scratch_dir))
+		return -1;
+	snprintf(fake_bin, sizeof(fake_bin), "%s/fake-povray", scratch_dir);
+	write_file(fake_bin, fake_script);
+	if (chmod(fake_bin, 0755))
+		return -1;
+	unsetenv("POVPRESS_POVRAY");
+	return 0;
+}
+
+static int teardown_dir(void **state)
+{
+	(void)state;
+	return run("rm -rf '%s'", scratch_dir) == 0 ? 0 : -1;
+}
+
+static void assert_contains(const char *s, const char *part)
+{
+	if (!s || !strstr(s, part))
+		fail_msg("\"%s\" does not contain \"%s\"", s ? s : "(null)", part);
+}
+
+static void assert_argv(char **argv, const char *const *want, int n)
+{
+	for (int i = 0; i < n; i++) {
+		if (!argv[i])
+			fail_msg("argv ends at %d, wanted '%s'", i, want[i]);
+		if (strcmp(argv[i], want[i]))
+			fail_msg("argv[%d] is '%s', wanted '%s'", i, argv[i], want[i]);
+	}
+	if (argv[n])
+		fail_msg("argv has an extra element '%s'", argv[n]);
+}
+
+/* Run jobs in a pool; returns pov_pool_run()'s value. */
+static int run_pool(const struct pov_job *jobs, size_t n, int max_jobs, double timeout_s,
+		    int retries, struct pov_result *res)
+{
+	struct pov_pool_opts o;
+	char err[512] = "";
+	int rc;
+
+	pov_pool_opts_init(&o);
+	o.max_jobs = max_jobs;
+	o.timeout_s = timeout_s;
+	o.grace_s = 1.0;
+	o.retries = retries;
+	rc = pov_pool_run(jobs, n, &o, res, err, sizeof(err));
+	if (rc < 0)
+		print_message("pool: %s\n", err);
+	return rc;
+}
+
+static void release_all(struct pov_result *res, size_t n)
+{
+	for (size_t i = 0; i < n; i++)
+		pov_result_release(&res[i]);
+}
+
+/* ---- argument vectors --------------------------------------------------- */
+
+static void test_argv_order_and_quoting(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], want_l[PATH_MAX + 8],
+	     want_i[PATH_MAX + 8], want_o[PATH_MAX + 8], err[512];
+	static const struct pov_define defs[] = { { "AreaN", "5" }, { "Jitter", "-0.25" } };
+	static const char *const extra[] = { "+AM2", "+A0.1", "+W32" };
+	struct pov_job job = { 0 };
+	char **argv;
+	int argc;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "argv dir"), "a b.pov");
+	scratch(out, sizeof(out), "argv dir/out put.exr");
+	job.scene = scene;
+	job.output = out;
+	job.width = 64;
+	job.height = 48;
+	job.threads = 3;
+	job.defines = defs;
+	job.ndefines = 2;
+	job.extra = extra;
+	job.nextra = 3;
+	assert_int_equal(pov_argv_build(&job, &argv, &argc, err, sizeof(err)), 0);
+	snprintf(want_l, sizeof(want_l), "+L\"%s\"", dir);
+	snprintf(want_i, sizeof(want_i), "+I\"%s\"", scene);
+	snprintf(want_o, sizeof(want_o), "+O\"%s\"", out);
+	const char *const want[] = { "povray", "-D", "+FE", "-GR", "-V", "+W64", "+H48", "+WT3",
+				     want_l, want_i, want_o, "Declare=AreaN=5",
+				     "Declare=Jitter=-0.25", "+AM2", "+A0.1", "+W32" };
+	assert_int_equal(argc, 16);
+	assert_argv(argv, want, 16);
+	pov_argv_free(argv);
+
+	/* The binary: job->povray, then $POVPRESS_POVRAY, then "povray". */
+	setenv("POVPRESS_POVRAY", "/opt/pov/bin/povray", 1);
+	assert_int_equal(pov_argv_build(&job, &argv, NULL, err, sizeof(err)), 0);
+	assert_string_equal(argv[0], "/opt/pov/bin/povray");
+	pov_argv_free(argv);
+	job.povray = "my-povray";
+	assert_int_equal(pov_argv_build(&job, &argv, NULL, err, sizeof(err)), 0);
+	assert_string_equal(argv[0], "my-povray");
+	pov_argv_free(argv);
+	unsetenv("POVPRESS_POVRAY");
+	pov_argv_free(NULL);
+}
+
+static void test_argv_region(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512];
+	struct pov_job job = { 0 };
+	struct pov_region r;
+	char **argv;
+	int argc;
+	static const struct {
+		int w, h;
+		struct pov_region r;
+		const char *sc, *ec, *sr, *er;
+	} cases[] = {
+		{ 64, 48, { 8, 4, 23, 11 }, "+SC9", "+EC24", "+SR5", "+ER12" },
+		/* POV-Ray reads an end of 1 as the fraction 1.0, the last column */
+		{ 64, 48, { 0, 0, 0, 0 }, "+SC1", "+EC1.5", "+SR1", "+ER1.5" },
+		{ 64, 48, { 63, 47, 63, 47 }, "+SC64", "+EC64", "+SR48", "+ER48" },
+		{ 64, 48, { 0, 1, 63, 1 }, "+SC1", "+EC64", "+SR2", "+ER2" },
+		{ 1, 1, { 0, 0, 0, 0 }, "+SC1", "+EC1", "+SR1", "+ER1" },
+	};
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "region"), "r.pov");
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "region/r.exr");
+	for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
+		job.width = cases[k].w;
+		job.height = cases[k].h;
+		r = cases[k].r;
+		job.region = &r;
+		assert_int_equal(pov_argv_build(&job, &argv, &argc, err, sizeof(err)), 0);
+		assert_string_equal(argv[7], cases[k].sc);
+		assert_string_equal(argv[8], cases[k].ec);
+		assert_string_equal(argv[9], cases[k].sr);
+		assert_string_equal(argv[10], cases[k].er);
+		assert_int_equal(argc, 14);
+		pov_argv_free(argv);
+	}
+	/* Whole image: no region options at all. */
+	job.region = NULL;
+	assert_int_equal(pov_argv_build(&job, &argv, &argc, err, sizeof(err)), 0);
+	assert_int_equal(argc, 10);
+	for (int i = 0; i < argc; i++)
+		assert_true(strncmp(argv[i], "+S", 2) && strncmp(argv[i], "+E", 2));
+	pov_argv_free(argv);
+}
+
+static void test_argv_bad_jobs(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], p[PATH_MAX], err[512];
+	struct pov_job job = { 0 }, j;
+	struct pov_region r;
+	struct pov_define d;
+	char **argv = (char **)&job;	/* must come back NULL */
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "bad"), "s.pov");
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "bad/o.exr");
+	job.width = 32;
+	job.height = 24;
+
+	j = job;
+	j.scene = scratch(p, sizeof(p), "bad/missing.pov");
+	assert_int_equal(pov_argv_build(&j, &argv, NULL, err, sizeof(err)), -1);
+	assert_null(argv);
+	assert_contains(err, "cannot read scene '");
+	assert_contains(err, "missing.pov': No such file or directory");
+
+	j = job;
+	j.output = scratch(p, sizeof(p), "bad/no such dir/o.exr");
+	assert_int_equal(pov_argv_build(&j, &argv, NULL, err, sizeof(err)), -1);
+	assert_contains(err, "no such dir/o.exr': No such file or directory");
+
+	j = job;
+	j.height = 0;
+	assert_int_equal(pov_argv_build(&j, &argv, NULL, err, sizeof(err)), -1);
+	assert_contains(err, "32x0");
+
+	j = job;
+	r = (struct pov_region){ 0, 0, 32, 5 };	/* x1 is past the last column */
+	j.region = &r;
+	assert_int_equal(pov_argv_build(&j, &argv, NULL, err, sizeof(err)), -1);
+	assert_contains(err, "region 0,0-32,5 of a 32x24 image");
+	r = (struct pov_region){ 5, 0, 4, 5 };	/* empty */
+	assert_int_equal(pov_argv_build(&j, &argv, NULL, err, sizeof(err)), -1);
+
+	j = job;
+	d = (struct pov_define){ "Name", "\"text\"" };
+	j.defines = &d;
+	j.ndefines = 1;
+	assert_int_equal(pov_argv_build(&j, &argv, NULL, err, sizeof(err)), -1);
+	assert_contains(err, "bad declare 'Name=\"text\"'");
+	d = (struct pov_define){ "2x", "1" };
+	assert_int_equal(pov_argv_build(&j, &argv, NULL, err, sizeof(err)), -1);
+	d = (struct pov_define){ "X", "1 2" };
+	assert_int_equal(pov_argv_build(&j, &argv, NULL, err, sizeof(err)), -1);
+
+	/* A double quote in the path needs a work directory for a link. */
+	j = job;
+	make_tiny_scene(p, sizeof(p), scratch(dir, sizeof(dir), "bad/q\"dir"), "s.pov");
+	j.scene = p;
+	assert_int_equal(pov_argv_build(&j, &argv, NULL, err, sizeof(err)), -1);
+	assert_contains(err, "cannot pass '");
+	assert_contains(err, "q\"dir/s.pov' to povray");
+	assert_contains(err, "no work directory");
+	assert_null(argv);
+}
+
+/* Paths POV-Ray cannot take go through links in the work directory. */
+static void test_argv_links(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], work[PATH_MAX], err[512];
+	char target[PATH_MAX], expect[PATH_MAX + 8];
+	struct stat st_link, st_real;
+	struct pov_job job = { 0 };
+	char **argv, **again;
+	ssize_t n;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "quo\"te \xc3\xa9"),
+			"sc\"ene.pov");
+	mkdir_p(scratch(work, sizeof(work), "work"));
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "quo\"te \xc3\xa9/out.exr");
+	job.width = 16;
+	job.height = 12;
+	job.workdir = work;
+	assert_int_equal(pov_argv_build(&job, &argv, NULL, err, sizeof(err)), 0);
+	/* +L, +I, +O: every path POV-Ray sees is printable ASCII without '"'
+	 * inside the quotes, and each link leads to the real thing. */
+	for (int i = 7; i <= 9; i++) {
+		const char *a = argv[i];
+		size_t len = strlen(a);
+		char path[PATH_MAX];
+
+		assert_true(a[0] == '+' && a[2] == '"' && a[len - 1] == '"');
+		snprintf(path, sizeof(path), "%.*s", (int)(len - 4), a + 3);
+		for (const char *c = path; *c; c++)
+			assert_true(*c >= 0x20 && *c < 0x7f && *c != '"');
+		assert_true(!strncmp(path, work, strlen(work)));
+		if (a[1] == 'O') {
+			/* the output's directory is linked, not the file */
+			char *slash = strrchr(path, '/');
+
+			assert_string_equal(slash, "/out.exr");
+			*slash = '\0';
+		}
+		n = readlink(path, target, sizeof(target) - 1);
+		assert_true(n > 0);
+		target[n] = '\0';
+		assert_int_equal(target[0], '/');
+		assert_int_equal(stat(target, &st_link), 0);
+		assert_int_equal(stat(a[1] == 'I' ? scene : dir, &st_real), 0);
+		assert_true(st_link.st_ino == st_real.st_ino && st_link.st_dev == st_real.st_dev);
+	}
+	/* The same paths reuse the same links. */
+	assert_int_equal(pov_argv_build(&job, &again, NULL, err, sizeof(err)), 0);
+	for (int i = 0; argv[i]; i++)
+		assert_string_equal(argv[i], again[i]);
+	pov_argv_free(again);
+	pov_argv_free(argv);
+
+	/* An output name POV-Ray cannot take, or one without ".exr", gets a
+	 * stand-in beside it. */
+	job.output = scratch(out, sizeof(out), "quo\"te \xc3\xa9/it's \"out\"");
+	assert_int_equal(pov_argv_build(&job, &argv, NULL, err, sizeof(err)), 0);
+	assert_contains(argv[9], "/.povpress-");
+	assert_contains(argv[9], ".exr\"");
+	pov_argv_free(argv);
+	job.output = scratch(out, sizeof(out), "plain.EXR");
+	assert_int_equal(pov_argv_build(&job, &argv, NULL, err, sizeof(err)), 0);
+	snprintf(expect, sizeof(expect), "+O\"%s/.povpress-", scratch_dir);
+	assert_true(!strncmp(argv[9], expect, strlen(expect)));
+	pov_argv_free(argv);
+
+	/* A work directory that is itself unsafe is refused. */
+	job.workdir = dir;
+	assert_int_equal(pov_argv_build(&job, &argv, NULL, err, sizeof(err)), -1);
+	assert_contains(err, "cannot use work directory");
+}
+
+/* ---- shell lines ---------------------------------------------------------- */
+
+static void test_shell_line_words(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512], want[PATH_MAX * 2];
+	static const char *const extra[] = { "+A0.1", "Antialias_Depth=3" };
+	struct pov_job job = { 0 };
+	char *line;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "shell it's"), "s.pov");
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "shell it's/o.exr");
+	job.width = 16;
+	job.height = 12;
+	job.extra = extra;
+	job.nextra = 2;
+	assert_int_equal(pov_shell_line(&job, &line, err, sizeof(err)), 0);
+	/* plain words stay bare; the rest is single-quoted with ' as '\'' */
+	snprintf(want, sizeof(want), "povray -D +FE -GR -V +W16 +H12 '+L\"%s/shell it'\\''s\"' ",
+		 scratch_dir);
+	if (strncmp(line, want, strlen(want)))
+		fail_msg("line \"%s\" does not start with \"%s\"", line, want);
+	assert_contains(line, " +A0.1 Antialias_Depth=3");
+	assert_null(strstr(line, "&&"));
+	assert_int_equal(line[strlen(line) - 1], '3');	/* no newline */
+	free(line);
+}
+
+/* The line, run by sh, gives the binary exactly the vector of pov_argv_build. */
+static void test_shell_line_round_trip_args(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], args[PATH_MAX], work[PATH_MAX];
+	char err[512];
+	static const char *const extra[] = { "+A0.1", "Odd=$HOME `x` \\ ; |&", "" };
+	struct pov_job job = { 0 };
+	char *line, *got, **argv;
+	int argc;
+	size_t pos = 0;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "rt 'q' \"d\" $x"),
+			"s c.pov");
+	mkdir_p(scratch(work, sizeof(work), "work"));
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "rt 'q' \"d\" $x/o.exr");
+	job.width = 16;
+	job.height = 12;
+	job.extra = extra;
+	job.nextra = 3;
+	job.workdir = work;
+	job.povray = fake_bin;
+	assert_int_equal(pov_shell_line(&job, &line, err, sizeof(err)), 0);
+	assert_int_equal(pov_argv_build(&job, &argv, &argc, err, sizeof(err)), 0);
+	scratch(args, sizeof(args), "args.bin");
+	setenv("FAKE_MODE", "args", 1);
+	setenv("FAKE_ARGS", args, 1);
+	assert_int_equal(sh_c(line), 0);
+	got = read_file(args);
+	assert_non_null(got);
+	/* $0 is the script; then argv[1..] in order, NUL-terminated */
+	for (int i = 1; i < argc; i++) {
+		assert_string_equal(got + pos, argv[i]);
+		pos += strlen(argv[i]) + 1;
+	}
+	free(got);
+	free(line);
+	pov_argv_free(argv);
+}
+
+/* The line renders for real: spaces, a single quote, and a name without
+ * ".exr" (a stand-in renamed by the line's mv). */
+static void test_shell_line_renders(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512];
+	struct pov_job job = { 0 };
+	struct image img = { 0 };
+	char *line;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "sh render's dir"),
+			"the scene.pov");
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "sh render's dir/final image");
+	job.width = 24;
+	job.height = 16;
+	assert_int_equal(pov_shell_line(&job, &line, err, sizeof(err)), 0);
+	assert_contains(line, " && mv -f -- ");
+	assert_int_equal(sh_c(line), 0);
+	assert_true(exists(out));
+	assert_int_equal(image_read_exr(out, &img, err, sizeof(err)), 0);
+	assert_int_equal(img.w, 24);
+	assert_int_equal(img.h, 16);
+	image_release(&img);
+	free(line);
+}
+
+/* ---- statistics ----------------------------------------------------------- */
+
+static void parse_fixture(const char *name, struct pov_stats *st, int want_rc)
+{
+	char path[256];
+	char *text;
+
+	snprintf(path, sizeof(path), DATA "%s", name);
+	text = read_file(path);
+	if (!text)
+		fail_msg("cannot read fixture '%s'", path);
+	assert_int_equal(pov_stats_parse(text, st), want_rc);
+	free(text);
+}
+
+static void test_stats_no_aa(void **state)
+{
+	struct pov_stats st;
+
+	(void)state;
+	parse_fixture("noaa.txt", &st, 0);
+	assert_int_equal(st.have, POV_HAVE_PARSE | POV_HAVE_BOUNDING | POV_HAVE_TRACE |
+				  POV_HAVE_PIXELS | POV_HAVE_RAYS);
+	assert_int_equal(st.pixels, 3072);
+	assert_int_equal(st.samples, 0);
+	assert_float_equal(st.samples_per_pixel, 0.0, 0);
+	assert_int_equal(st.rays, 3072);
+	assert_int_equal(st.rays_saved, 0);
+	assert_float_equal(st.parse.wall_s, 0.004, 1e-12);
+	assert_int_equal(st.parse.threads, 1);
+	assert_float_equal(st.trace.wall_s, 0.011, 1e-12);
+	assert_float_equal(st.trace.cpu_s, 0.005, 1e-12);
+	assert_int_equal(st.trace.threads, 2);
+	assert_float_equal(st.photon.wall_s, 0.0, 0);
+	assert_float_equal(st.radiosity.wall_s, 0.0, 0);
+}
+
+static void test_stats_aa(void **state)
+{
+	struct pov_stats st;
+
+	(void)state;
+	parse_fixture("aa.txt", &st, 0);
+	assert_int_equal(st.pixels, 3300);
+	assert_int_equal(st.samples, 24524);
+	assert_float_equal(st.samples_per_pixel, 7.43, 1e-12);
+	assert_int_equal(st.rays, 27824);	/* pixels + samples */
+	assert_float_equal(st.trace.wall_s, 0.070, 1e-12);
+	assert_float_equal(st.trace.cpu_s, 0.033, 1e-12);
+}
+
+/* The default console (option summaries, \r progress lines) and a region. */
+static void test_stats_verbose_region(void **state)
+{
+	struct pov_stats st;
+
+	(void)state;
+	parse_fixture("region-verbose.txt", &st, 0);
+	assert_int_equal(st.pixels, 153);
+	assert_int_equal(st.samples, 2179);
+	assert_float_equal(st.samples_per_pixel, 14.24, 1e-12);
+	assert_int_equal(st.rays, 2332);
+	assert_float_equal(st.trace.wall_s, 0.012, 1e-12);
+}
+
+static void test_stats_radiosity_photons(void **state)
+{
+	struct pov_stats st;
+
+	(void)state;
+	parse_fixture("radiosity.txt", &st, 0);
+	assert_true(st.have & POV_HAVE_RADIOSITY);
+	assert_false(st.have & POV_HAVE_PHOTON);
+	assert_float_equal(st.radiosity.wall_s, 0.028, 1e-12);
+	assert_float_equal(st.radiosity.cpu_s, 0.015, 1e-12);
+	assert_float_equal(st.trace.wall_s, 0.023, 1e-12);
+	assert_int_equal(st.pixels, 5577);
+	assert_int_equal(st.rays, 20347);
+
+	parse_fixture("photons.txt", &st, 0);
+	assert_true(st.have & POV_HAVE_PHOTON);
+	assert_false(st.have & POV_HAVE_RADIOSITY);
+	assert_float_equal(st.photon.wall_s, 0.002, 1e-12);
+	assert_int_equal(st.photon.threads, 5);
+	/* "Refracted Rays: 774" is not the ray count */
+	assert_int_equal(st.rays, 4192);
+	assert_float_equal(st.trace.wall_s, 0.019, 1e-12);
+}
+
+static void test_stats_missing_and_odd(void **state)
+{
+	struct pov_stats st;
+
+	(void)state;
+	parse_fixture("parse-error.txt", &st, -1);
+	assert_false(st.have & (POV_HAVE_PIXELS | POV_HAVE_TRACE));
+	assert_int_equal(pov_stats_parse(NULL, &st), -1);
+	assert_int_equal(st.have, 0);
+	assert_int_equal(pov_stats_parse("", &st), -1);
+
+	/* Long times, "-" for no pixels, no final newline, CRLF. */
+	assert_int_equal(pov_stats_parse(
+		"Pixels:                0   Samples:               0   Smpls/Pxl: -\r\n"
+		"Rays:         1234567890   Saved:                12   Max Level: 1/5\r\n"
+		"  Trace Time:       1 hours  2 minutes  5 seconds (3725.500 seconds)\r\n"
+		"              using 16 thread(s) with 59000.250 CPU-seconds total", &st), 0);
+	assert_int_equal(st.pixels, 0);
+	assert_float_equal(st.samples_per_pixel, 0.0, 0);
+	assert_int_equal(st.rays, 1234567890LL);
+	assert_int_equal(st.rays_saved, 12);
+	assert_float_equal(st.trace.wall_s, 3725.5, 1e-9);
+	assert_float_equal(st.trace.cpu_s, 59000.25, 1e-9);
+	assert_int_equal(st.trace.threads, 16);
+}
+
+/* ---- pool sizing and the binary ------------------------------------------ */
+
+static void test_pool_size(void **state)
+{
+	int jobs, threads;
+
+	(void)state;
+	pov_pool_size(8, 100, 0, &jobs, &threads);
+	assert_int_equal(jobs, 8);
+	assert_int_equal(threads, 1);
+	pov_pool_size(8, 1, 0, &jobs, &threads);	/* one big job: all cores */
+	assert_int_equal(jobs, 1);
+	assert_int_equal(threads, 8);
+	pov_pool_size(8, 3, 0, &jobs, &threads);
+	assert_int_equal(jobs, 3);
+	assert_int_equal(threads, 2);
+	pov_pool_size(8, 100, 2, &jobs, &threads);	/* --jobs 2 */
+	assert_int_equal(jobs, 2);
+	assert_int_equal(threads, 4);
+	pov_pool_size(2, 100, 6, &jobs, &threads);	/* more jobs than cores, asked for */
+	assert_int_equal(jobs, 6);
+	assert_int_equal(threads, 1);
+	pov_pool_size(0, 0, 0, &jobs, &threads);
+	assert_int_equal(jobs, 1);
+	assert_int_equal(threads, 1);
+	for (int c = 1; c <= 16; c++)
+		for (size_t n = 1; n <= 20; n++) {
+			pov_pool_size(c, n, 0, &jobs, &threads);
+			assert_true(jobs >= 1 && threads >= 1 && jobs * threads <= c);
+		}
+	assert_true(pov_cpu_count() >= 1);
+}
+
+static void test_missing_binary(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], path[PATH_MAX], err[512];
+	struct pov_job job = { 0 };
+	struct pov_result res[2];
+	struct pov_pool_opts o;
+	char *old_path = getenv("PATH") ? strdup(getenv("PATH")) : NULL;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "nobin"), "s.pov");
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "nobin/o.exr");
+	job.width = 8;
+	job.height = 8;
+	pov_pool_opts_init(&o);
+
+	/* Not on PATH. */
+	setenv("PATH", "/nonexistent-bin:/also-not-here", 1);
+	assert_int_equal(pov_find_binary(&job, path, sizeof(path), err, sizeof(err)), -1);
+	assert_contains(err, "cannot run 'povray': No such file or directory");
+	assert_contains(err, "POVPRESS_POVRAY");
+	err[0] = '\0';
+	assert_int_equal(pov_pool_run(&job, 1, &o, res, err, sizeof(err)), -1);
+	assert_contains(err, "cannot run 'povray': No such file or directory");
+	assert_int_equal(res[0].attempts, 0);
+	if (old_path)
+		setenv("PATH", old_path, 1);
+	free(old_path);
+	assert_int_equal(pov_find_binary(&job, path, sizeof(path), err, sizeof(err)), 0);
+	assert_true(path[0] == '/');
+
+	/* Named by the environment. */
+	setenv("POVPRESS_POVRAY", "/nonexistent-dir/povray-3.7", 1);
+	assert_int_equal(pov_pool_run(&job, 1, &o, res, err, sizeof(err)), -1);
+	assert_contains(err, "cannot run '/nonexistent-dir/povray-3.7' (from POVPRESS_POVRAY): "
+			     "No such file or directory");
+	unsetenv("POVPRESS_POVRAY");
+
+	/* Named by the job, and not executable. */
+	job.povray = scene;
+	assert_int_equal(pov_pool_run(&job, 1, &o, res, err, sizeof(err)), -1);
+	assert_contains(err, "Permission denied");
+	assert_contains(err, "s.pov'");
+	assert_false(exists(out));
+}
+
+/* ---- the pool with a fake povray ------------------------------------------ */
+
+static void count_done(void *arg, size_t index, const struct pov_result *res)
+{
+	int *calls = arg;
+
+	(void)res;
+	calls[index]++;
+}
+
+/* Never more than K children at once, and K reached. */
+static void test_pool_limit(void **state)
+{
+	enum { N = 7, K = 3 };
+	char dir[PATH_MAX], scene[PATH_MAX], log[PATH_MAX], err[512];
+	char outs[N][PATH_MAX];
+	struct pov_job jobs[N];
+	struct pov_result res[N];
+	struct pov_pool_opts o;
+	double s[N], e[N];
+	int calls[N] = { 0 }, maxlive = 0;
+	FILE *f;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "limit"), "s.pov");
+	scratch(log, sizeof(log), "limit/times.log");
+	unlink(log);
+	setenv("FAKE_MODE", "sleep", 1);
+	setenv("FAKE_LOG", log, 1);
+	for (int i = 0; i < N; i++) {
+		char name[64];
+
+		snprintf(name, sizeof(name), "limit/o%d.exr", i);
+		memset(&jobs[i], 0, sizeof(jobs[i]));
+		jobs[i].scene = scene;
+		jobs[i].output = scratch(outs[i], sizeof(outs[i]), name);
+		jobs[i].width = 8;
+		jobs[i].height = 8;
+		jobs[i].povray = fake_bin;
+	}
+	pov_pool_opts_init(&o);
+	o.max_jobs = K;
+	o.on_done = count_done;
+	o.arg = calls;
+	assert_int_equal(pov_pool_run(jobs, N, &o, res, err, sizeof(err)), 0);
+	for (int i = 0; i < N; i++) {
+		assert_int_equal(res[i].status, POV_OK);
+		assert_int_equal(res[i].attempts, 1);
+		assert_int_equal(calls[i], 1);
+		assert_true(exists(outs[i]));
+		assert_true(res[i].wall_s >= 0.3);
+		assert_true(res[i].end_s - res[i].start_s >= 0.3);
+	}
+	/* The children's own clocks. */
+	f = fopen(log, "r");
+	assert_non_null(f);
+	for (int i = 0; i < N; i++)
+		assert_int_equal(fscanf(f, "%lf %lf", &s[i], &e[i]), 2);
+	fclose(f);
+	for (int i = 0; i < N; i++) {
+		int live = 0;
+
+		for (int k = 0; k < N; k++)
+			live += s[k] <= s[i] && s[i] < e[k];
+		if (live > maxlive)
+			maxlive = live;
+	}
+	assert_int_equal(maxlive, K);
+	/* The same from the pool's records. */
+	maxlive = 0;
+	for (int i = 0; i < N; i++) {
+		int live = 0;
+
+		for (int k = 0; k < N; k++)
+			live += res[k].start_s <= res[i].start_s && res[i].start_s < res[k].end_s;
+		if (live > maxlive)
+			maxlive = live;
+	}
+	assert_int_equal(maxlive, K);
+	release_all(res, N);
+}
+
+static void test_pool_crash_retry_and_no_output(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX];
+	struct pov_job job = { 0 };
+	struct pov_result res;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "crash"), "s.pov");
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "crash/o.exr");
+	job.width = 8;
+	job.height = 8;
+	job.povray = fake_bin;
+
+	setenv("FAKE_MODE", "segv", 1);
+	assert_int_equal(run_pool(&job, 1, 1, 0, 1, &res), 0);
+	assert_int_equal(res.status, POV_CRASHED);
+	assert_int_equal(res.attempts, 2);	/* retried once */
+	assert_int_equal(res.term_signal, SIGSEGV);
+	assert_int_equal(res.exit_status, -1);
+	assert_contains(res.message, "killed by signal 11");
+	pov_result_release(&res);
+	assert_int_equal(run_pool(&job, 1, 1, 0, 0, &res), 0);
+	assert_int_equal(res.attempts, 1);	/* retries 0 */
+	pov_result_release(&res);
+
+	/* Exit 0 but no file: a failure, not retried. */
+	write_file(out, "stale");	/* removed before the attempt */
+	setenv("FAKE_MODE", "noout", 1);
+	assert_int_equal(run_pool(&job, 1, 1, 0, 1, &res), 0);
+	assert_int_equal(res.status, POV_FAILED);
+	assert_int_equal(res.attempts, 1);
+	assert_int_equal(res.exit_status, 0);
+	assert_contains(res.message, "povray did not write '");
+	assert_false(exists(out));
+	pov_result_release(&res);
+	pov_result_release(&res);	/* a zeroed result is a no-op */
+}
+
+/* POV-Ray's messages, from captured output played back by the fake. */
+static void test_pool_error_messages(void **state)
+{
+	static const struct {
+		const char *fixture, *want, *not;
+	} cases[] = {
+		{ "parse-error.txt",
+		  "(exit status 1) on '%s': File '/tmp/my scenes/bad.pov' line 5: Parse Error: "
+		  "No matching } in 'pigment', undeclared identifier 'colr' found instead", NULL },
+		{ "include-error.txt",
+		  "File '/tmp/missing_include.pov' line 2: Parse Error: Cannot open include file "
+		  "nonexistent.inc.", "Possible" },
+		{ "bad-region.txt", "Fatal error in renderer: Invalid end column or row", NULL },
+		{ "bad-option.txt", "Problem with option setting; Failed to parse command-line "
+				    "option", "user configuration" },
+	};
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], path[PATH_MAX], want[512];
+	struct pov_job job = { 0 };
+	struct pov_result res;
+	size_t base;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "msgs"), "s.pov");
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "msgs/o.exr");
+	job.width = 8;
+	job.height = 8;
+	job.povray = fake_bin;
+	setenv("FAKE_MODE", "fixture", 1);
+	assert_non_null(getcwd(path, sizeof(path) - 64));
+	base = strlen(path);
+	for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
+		snprintf(path + base, sizeof(path) - base, "/" DATA "%s", cases[k].fixture);
+		setenv("FAKE_FIXTURE", path, 1);
+		assert_int_equal(run_pool(&job, 1, 1, 0, 1, &res), 0);
+		assert_int_equal(res.status, POV_FAILED);
+		assert_int_equal(res.attempts, 1);
+		assert_int_equal(res.exit_status, 1);
+		snprintf(want, sizeof(want), cases[k].want, scene);
+		assert_contains(res.message, want);
+		if (cases[k].not && strstr(res.message, cases[k].not))
+			fail_msg("\"%s\" contains \"%s\"", res.message, cases[k].not);
+		assert_non_null(res.log);
+		pov_result_release(&res);
+	}
+}
+
+/* ---- the pool with the real povray ---------------------------------------- */
+
+static void assert_pixel(const struct image *img, int x, int y, int nonzero)
+{
+	int any = 0;
+
+	for (int c = 0; c < img->nch; c++)
+		any |= img->px[((size_t)y * img->w + x) * img->nch + c] != 0.0f;
+	if (any != nonzero)
+		fail_msg("pixel (%d, %d) is %s", x, y, any ? "not black" : "black");
+}
+
+/* A scene with an include beside it, in a directory with a space; and the
+ * same in directories with a double quote and non-ASCII bytes. */
+static void test_render_awkward_paths(void **state)
+{
+	char d0[PATH_MAX], d1[PATH_MAX], s0[PATH_MAX], s1[PATH_MAX], o0[PATH_MAX],
+	     o1[PATH_MAX], work[PATH_MAX], err[512];
+	struct pov_job jobs[2];
+	struct pov_result res[2];
+	struct image img = { 0 };
+
+	(void)state;
+	make_tiny_scene(s0, sizeof(s0), scratch(d0, sizeof(d0), "my scenes"), "tiny scene.pov");
+	make_tiny_scene(s1, sizeof(s1), scratch(d1, sizeof(d1), "say \"cheese\" \xc3\xa9"),
+			"it's \"tiny\".pov");
+	mkdir_p(scratch(work, sizeof(work), "work"));
+	memset(jobs, 0, sizeof(jobs));
+	jobs[0].scene = s0;
+	jobs[0].output = scratch(o0, sizeof(o0), "my scenes/out image.exr");
+	jobs[1].scene = s1;
+	jobs[1].output = scratch(o1, sizeof(o1), "say \"cheese\" \xc3\xa9/\"out\" \xc3\xa9.exr");
+	jobs[1].workdir = work;
+	for (int i = 0; i < 2; i++) {
+		jobs[i].width = 32;
+		jobs[i].height = 24;
+		jobs[i].threads = 1;
+	}
+	write_file(o1, "stale");
+	assert_int_equal(run_pool(jobs, 2, 2, 20, 0, res), 0);
+	for (int i = 0; i < 2; i++) {
+		if (res[i].status != POV_OK)
+			fail_msg("job %d: %s\n%s", i, res[i].message, res[i].log ? res[i].log : "");
+		assert_int_equal(res[i].exit_status, 0);
+		assert_true(res[i].wall_s > 0.05 && res[i].wall_s < 20);
+		assert_true(res[i].cpu_s > 0 && res[i].cpu_s < 20);
+		assert_true(res[i].stats.have & POV_HAVE_TRACE);
+		assert_int_equal(res[i].stats.pixels, 32 * 24);
+		assert_int_equal(res[i].stats.trace.threads, 1);
+		assert_contains(res[i].log, "POV-Ray finished");
+		assert_string_equal(res[i].message, "");
+		assert_int_equal(image_read_exr(jobs[i].output, &img, err, sizeof(err)), 0);
+		assert_int_equal(img.w, 32);
+		assert_int_equal(img.h, 24);
+		assert_int_equal(img.nch, 3);
+		assert_pixel(&img, 0, 0, 1);	/* background */
+		assert_pixel(&img, 16, 12, 1);	/* sphere */
+		image_release(&img);
+	}
+	/* No stand-in or state file is left beside the output. */
+	assert_int_equal(count_entries(d1, "povpress"), 0);
+	assert_int_equal(count_entries(d1, "pov-state"), 0);
+	assert_int_equal(count_entries(d1, ".exr"), 1);
+	release_all(res, 2);
+}
+
+static void test_render_region(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], o0[PATH_MAX], o1[PATH_MAX], err[512];
+	struct pov_region r0 = { 8, 4, 23, 11 }, r1 = { 0, 2, 0, 3 };
+	struct pov_job jobs[2];
+	struct pov_result res[2];
+	struct image img = { 0 };
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "region render"), "s.pov");
+	memset(jobs, 0, sizeof(jobs));
+	for (int i = 0; i < 2; i++) {
+		jobs[i].scene = scene;
+		jobs[i].width = 32;
+		jobs[i].height = 24;
+		jobs[i].threads = 1;
+	}
+	jobs[0].output = scratch(o0, sizeof(o0), "region render/r0.exr");
+	jobs[0].region = &r0;
+	jobs[1].output = scratch(o1, sizeof(o1), "region render/r1.exr");
+	jobs[1].region = &r1;	/* one column: POV-Ray's "+EC1" trap */
+	assert_int_equal(run_pool(jobs, 2, 2, 20, 0, res), 0);
+	assert_int_equal(res[0].status, POV_OK);
+	assert_int_equal(res[1].status, POV_OK);
+	assert_int_equal(res[0].stats.pixels, 16 * 8);
+	assert_int_equal(res[1].stats.pixels, 2);
+
+	for (int i = 0; i < 2; i++) {
+		const struct pov_region *r = jobs[i].region;
+
+		assert_int_equal(image_read_exr(jobs[i].output, &img, err, sizeof(err)), 0);
+		assert_int_equal(img.w, 32);	/* full size */
+		assert_int_equal(img.h, 24);
+		for (int y = 0; y < img.h; y++)
+			for (int x = 0; x < img.w; x++)
+				assert_pixel(&img, x, y, x >= r->x0 && x <= r->x1 && y >= r->y0 &&
+							 y <= r->y1);
+		image_release(&img);
+	}
+	release_all(res, 2);
+}
+
+static void test_render_parse_error(void **state)
+{
+	static const char bad[] =
+		"#version 3.7;\n"
+		"global_settings { assumed_gamma 1.0 }\n"
+		"camera { location <0, 0, -3> look_at 0 }\n"
+		"sphere { 0, 1 pigment { color rgb 1 } }\n"
+		"sphere { 0, 1 pigment { colr rgb 1 } }\n";
+	char d0[PATH_MAX], d1[PATH_MAX], s0[PATH_MAX], s1[PATH_MAX], o0[PATH_MAX],
+	     o1[PATH_MAX], work[PATH_MAX], want[PATH_MAX + 64];
+	struct pov_job jobs[2];
+	struct pov_result res[2];
+
+	(void)state;
+	mkdir_p(scratch(d0, sizeof(d0), "broken scenes"));
+	mkdir_p(scratch(d1, sizeof(d1), "broken \"scenes\""));
+	mkdir_p(scratch(work, sizeof(work), "work"));
+	write_file(scratch(s0, sizeof(s0), "broken scenes/bad one.pov"), bad);
+	write_file(scratch(s1, sizeof(s1), "broken \"scenes\"/bad.pov"), bad);
+	memset(jobs, 0, sizeof(jobs));
+	jobs[0].scene = s0;
+	jobs[0].output = scratch(o0, sizeof(o0), "broken scenes/o.exr");
+	jobs[1].scene = s1;
+	jobs[1].output = scratch(o1, sizeof(o1), "broken \"scenes\"/o.exr");
+	jobs[1].workdir = work;
+	for (int i = 0; i < 2; i++) {
+		jobs[i].width = 16;
+		jobs[i].height = 12;
+	}
+	assert_int_equal(run_pool(jobs, 2, 2, 20, 1, res), 0);
+	for (int i = 0; i < 2; i++) {
+		assert_int_equal(res[i].status, POV_FAILED);
+		assert_int_equal(res[i].attempts, 1);	/* a parse error is not retried */
+		assert_int_equal(res[i].exit_status, 1);
+		/* POV-Ray's own words, with the path the user gave, not a link */
+		snprintf(want, sizeof(want), "File '%s' line 5: Parse Error: No matching } in "
+			 "'pigment', undeclared identifier 'colr' found instead", jobs[i].scene);
+		assert_contains(res[i].message, want);
+		assert_null(strstr(res[i].message, "povpress-"));
+		assert_false(exists(jobs[i].output));
+	}
+	release_all(res, 2);
+}
+
+/* A render that would take over 10 s, a 1 s timeout: killed, retried once,
+ * killed again, and nothing left running or on disk. */
+static void test_timeout_kills(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], tag[64], name[128], st[PATH_MAX];
+	struct pov_job job;
+	struct pov_result res;
+	double t;
+
+	(void)state;
+	snprintf(tag, sizeof(tag), "povpress-timeout-%d", (int)getpid());
+	mkdir_p(scratch(dir, sizeof(dir), "slow"));
+	write_file(scratch(scene, sizeof(scene), "slow/slow.pov"), slow_scene);
+	snprintf(name, sizeof(name), "slow/%s.exr", tag);
+	slow_job(&job, scene, scratch(out, sizeof(out), name));
+	t = now_s();
+	assert_int_equal(run_pool(&job, 1, 1, 1.0, 1, &res), 0);
+	t = now_s() - t;
+	assert_int_equal(res.status, POV_TIMED_OUT);
+	assert_int_equal(res.attempts, 2);
+	assert_contains(res.message, "timed out after 1 s");
+	/* two attempts of 1 s, each stopped within the 1 s grace */
+	assert_true(t >= 2.0 && t < 6.0);
+	assert_true(res.wall_s >= 2.0 && res.wall_s < 6.0);
+	assert_true(res.cpu_s > 0.2);
+	assert_int_equal(count_procs(tag), 0);
+	assert_false(exists(out));
+	snprintf(name, sizeof(name), "slow/%s.pov-state", tag);
+	assert_false(exists(scratch(st, sizeof(st), name)));
+	pov_result_release(&res);
+}
+
+/*
+ * In a child process: run three slow jobs two at a time; exit 42 if the pool
+ * reported POV_INTERRUPTED with the signal, the two running jobs cancelled
+ * and the third never started.
+ */
+static void interrupted_child(const char *scene, const char *tag, int want_sig)
+{
+	char outs[3][PATH_MAX];
+	struct pov_job jobs[3];
+	struct pov_result res[3];
+	struct pov_pool_opts o;
+	char err[512];
+	int rc, ok;
+
+	for (int i = 0; i < 3; i++) {
+		snprintf(outs[i], sizeof(outs[i]), "%s/slow/%s-%d.exr", scratch_dir, tag, i);
+		slow_job(&jobs[i], scene, outs[i]);
+	}
+	pov_pool_opts_init(&o);
+	o.max_jobs = 2;
+	o.grace_s = 2.0;
+	rc = pov_pool_run(jobs, 3, &o, res, err, sizeof(err));
+	ok = rc == POV_INTERRUPTED && pov_signal_received() == want_sig &&
+	     res[0].status == POV_CANCELLED && res[1].status == POV_CANCELLED &&
+	     res[0].attempts == 1 && res[1].attempts == 1 && res[2].status == POV_CANCELLED &&
+	     res[2].attempts == 0 && strstr(res[2].message, "not started");
+	if (!ok)
+		fprintf(stderr, "child: rc %d sig %d: %s / %s / %s\n", rc, pov_signal_received(),
+			res[0].message, res[1].message, res[2].message);
+	_exit(ok ? 42 : 1);
+}
+
+static void signal_during_pool(int sig)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], tag[64];
+	pid_t pid;
+	int st = 0, n;
+	double t;
+
+	snprintf(tag, sizeof(tag), "povpress-sig%d-%d", sig, (int)getpid());
+	mkdir_p(scratch(dir, sizeof(dir), "slow"));
+	write_file(scratch(scene, sizeof(scene), "slow/slow.pov"), slow_scene);
+	fflush(NULL);
+	pid = fork();
+	assert_true(pid >= 0);
+	if (pid == 0)
+		interrupted_child(scene, tag, sig);
+	n = wait_procs(tag, 2, 10.0);
+	if (n != 2) {
+		kill(pid, SIGKILL);
+		waitpid(pid, &st, 0);
+		fail_msg("%d povray children running, wanted 2", n);
+	}
+	pause_s(0.3);	/* well into the render */
+	t = now_s();
+	kill(pid, sig);
+	while (waitpid(pid, &st, WNOHANG) == 0 && now_s() - t < 10)
+		pause_s(0.02);
+	t = now_s() - t;
+	if (!WIFEXITED(st)) {
+		kill(pid, SIGKILL);
+		waitpid(pid, &st, 0);
+		fail_msg("the pool process did not exit after signal %d", sig);
+	}
+	assert_int_equal(WEXITSTATUS(st), 42);
+	assert_true(t < 4.0);	/* stopped within seconds */
+	assert_int_equal(count_procs(tag), 0);
+}
+
+static void test_sigint_stops_pool(void **state)
+{
+	(void)state;
+	signal_during_pool(SIGINT);
+}
+
+static void test_sigterm_stops_pool(void **state)
+{
+	(void)state;
+	signal_during_pool(SIGTERM);
+}
+
+/* Even a SIGKILLed povpress leaves no povray behind (PR_SET_PDEATHSIG). */
+static void test_sigkill_leaves_no_orphans(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], tag[64];
+	pid_t pid;
+	int st, n;
+
+	(void)state;
+	snprintf(tag, sizeof(tag), "povpress-kill-%d", (int)getpid());
+	mkdir_p(scratch(dir, sizeof(dir), "slow"));
+	write_file(scratch(scene, sizeof(scene), "slow/slow.pov"), slow_scene);
+	fflush(NULL);
+	pid = fork();
+	assert_true(pid >= 0);
+	if (pid == 0)
+		interrupted_child(scene, tag, SIGINT);
+	n = wait_procs(tag, 2, 10.0);
+	kill(pid, SIGKILL);
+	waitpid(pid, &st, 0);
+	assert_int_equal(n, 2);
+	assert_true(WIFSIGNALED(st) && WTERMSIG(st) == SIGKILL);
+	assert_int_equal(wait_procs(tag, 0, 3.0), 0);
+}
+
+/* A signal caught before the pool starts (the caller's own catch) stops it
+ * before anything runs. */
+static void test_signal_before_pool(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512];
+	struct pov_job job = { 0 };
+	struct pov_result res;
+	struct pov_pool_opts o;
+	struct sigaction before, after;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "early"), "s.pov");
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "early/o.exr");
+	job.width = 8;
+	job.height = 8;
+	job.povray = fake_bin;
+	sigaction(SIGINT, NULL, &before);
+	assert_int_equal(pov_signals_catch(err, sizeof(err)), 0);
+	assert_int_equal(pov_signal_received(), 0);
+	raise(SIGINT);
+	assert_int_equal(pov_signal_received(), SIGINT);
+	pov_pool_opts_init(&o);
+	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), POV_INTERRUPTED);
+	assert_int_equal(res.status, POV_CANCELLED);
+	assert_int_equal(res.attempts, 0);
+	assert_false(exists(out));
+	pov_signals_restore();
+	sigaction(SIGINT, NULL, &after);
+	assert_true(after.sa_handler == before.sa_handler);
+	pov_result_release(&res);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_argv_order_and_quoting),
+		cmocka_unit_test(test_argv_region),
+		cmocka_unit_test(test_argv_bad_jobs),
+		cmocka_unit_test(test_argv_links),
+		cmocka_unit_test(test_shell_line_words),
+		cmocka_unit_test(test_shell_line_round_trip_args),
+		cmocka_unit_test(test_shell_line_renders),
+		cmocka_unit_test(test_stats_no_aa),
+		cmocka_unit_test(test_stats_aa),
+		cmocka_unit_test(test_stats_verbose_region),
+		cmocka_unit_test(test_stats_radiosity_photons),
+		cmocka_unit_test(test_stats_missing_and_odd),
+		cmocka_unit_test(test_pool_size),
+		cmocka_unit_test(test_missing_binary),
+		cmocka_unit_test(test_pool_limit),
+		cmocka_unit_test(test_pool_crash_retry_and_no_output),
+		cmocka_unit_test(test_pool_error_messages),
+		cmocka_unit_test(test_render_awkward_paths),
+		cmocka_unit_test(test_render_region),
+		cmocka_unit_test(test_render_parse_error),
+		cmocka_unit_test(test_timeout_kills),
+		cmocka_unit_test(test_sigint_stops_pool),
+		cmocka_unit_test(test_sigterm_stops_pool),
+		cmocka_unit_test(test_sigkill_leaves_no_orphans),
+		cmocka_unit_test(test_signal_before_pool),
+	};
+
+	return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
+}
