@@ -13,6 +13,7 @@
  * knows the file size (which lets it reject chunks that run past the end
  * of a truncated file instead of reading garbage), and nothing is printed.
  */
+#include "driver/errbuf.h"
 #include "driver/image.h"
 
 #include <errno.h>
@@ -57,17 +58,6 @@ static void exr_msg_handler(exr_const_context_t ctxt, exr_result_t code, const c
 	snprintf(exr_msg, sizeof(exr_msg), "%s", msg);
 }
 
-static void set_err(char *err, size_t errlen, const char *fmt, ...)
-{
-	va_list ap;
-
-	if (!err || !errlen)
-		return;
-	va_start(ap, fmt);
-	vsnprintf(err, errlen, fmt, ap);
-	va_end(ap);
-}
-
 /*
  * Describe failure rv of an OpenEXRCore call: the library's own message if
  * it gave one, otherwise the generic text for the code.  The library
@@ -89,7 +79,7 @@ static void set_exr_err(char *err, size_t errlen, const char *verb, const char *
 	char why[sizeof(exr_msg)];
 
 	exr_describe(rv, why, sizeof(why));
-	set_err(err, errlen, "cannot %s '%s': %s", verb, path, why);
+	errbuf_printf(err, errlen, "cannot %s '%s': %s", verb, path, why);
 }
 
 /*
@@ -103,7 +93,7 @@ static void set_pixel_err(char *err, size_t errlen, const char *path, exr_result
 	char why[sizeof(exr_msg)];
 
 	exr_describe(rv, why, sizeof(why));
-	set_err(err, errlen, "cannot read '%s': truncated or corrupt pixel data (%s)",
+	errbuf_printf(err, errlen, "cannot read '%s': truncated or corrupt pixel data (%s)",
 		path, why);
 }
 
@@ -114,11 +104,11 @@ int image_init(struct image *img, int w, int h, int nch, const char *const *name
 
 	memset(img, 0, sizeof(*img));
 	if (w <= 0 || h <= 0 || nch <= 0) {
-		set_err(err, errlen, "invalid image size %dx%d with %d channels", w, h, nch);
+		errbuf_printf(err, errlen, "invalid image size %dx%d with %d channels", w, h, nch);
 		return -1;
 	}
 	if ((size_t)w > SIZE_MAX / sizeof(float) / (size_t)h / (size_t)nch) {
-		set_err(err, errlen, "image size %dx%d with %d channels is too large",
+		errbuf_printf(err, errlen, "image size %dx%d with %d channels is too large",
 			w, h, nch);
 		return -1;
 	}
@@ -141,7 +131,7 @@ int image_init(struct image *img, int w, int h, int nch, const char *const *name
 
 oom:
 	image_release(img);
-	set_err(err, errlen, "out of memory for a %dx%d image with %d channels", w, h, nch);
+	errbuf_printf(err, errlen, "out of memory for a %dx%d image with %d channels", w, h, nch);
 	return -1;
 }
 
@@ -284,7 +274,7 @@ static int read_chunk(struct reader *rd, const exr_chunk_info_t *ci, int x0, int
 	/* a corrupt file must not make us write outside the image */
 	if (x0 < 0 || y0 < 0 || ci->width <= 0 || ci->height <= 0 ||
 	    ci->width > img->w - x0 || ci->height > img->h - y0) {
-		set_err(rd->err, rd->errlen,
+		errbuf_printf(rd->err, rd->errlen,
 			"cannot read '%s': corrupt chunk %d (%dx%d pixels at %d,%d)",
 			rd->path, ci->idx, ci->width, ci->height, x0, y0);
 		return -1;
@@ -316,7 +306,7 @@ fail:
 	set_pixel_err(rd->err, rd->errlen, rd->path, rv);
 	return -1;
 bad_channel:
-	set_err(rd->err, rd->errlen, "cannot read '%s': chunk %d has unexpected channels",
+	errbuf_printf(rd->err, rd->errlen, "cannot read '%s': chunk %d has unexpected channels",
 		rd->path, ci->idx);
 	return -1;
 }
@@ -417,13 +407,13 @@ static int read_part0(struct reader *rd)
 		return -1;
 	}
 	if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) {
-		set_err(rd->err, rd->errlen, "cannot read '%s': deep images are not supported",
+		errbuf_printf(rd->err, rd->errlen, "cannot read '%s': deep images are not supported",
 			rd->path);
 		return -1;
 	}
 	rd->comp = comp;
 	if (dwa_unsupported(comp)) {
-		set_err(rd->err, rd->errlen, "cannot read '%s': %s compression needs OpenEXR "
+		errbuf_printf(rd->err, rd->errlen, "cannot read '%s': %s compression needs OpenEXR "
 			"3.2 or later (convert with 'oiiotool --compression zip')", rd->path,
 			comp == EXR_COMPRESSION_DWAA ? "DWAA" : "DWAB");
 		return -1;
@@ -431,25 +421,25 @@ static int read_part0(struct reader *rd)
 	w = (int64_t)dw.max.x - dw.min.x + 1;
 	h = (int64_t)dw.max.y - dw.min.y + 1;
 	if (w <= 0 || h <= 0 || w > INT_MAX || h > INT_MAX || !chl || chl->num_channels <= 0) {
-		set_err(rd->err, rd->errlen, "cannot read '%s': empty data window or no channels",
+		errbuf_printf(rd->err, rd->errlen, "cannot read '%s': empty data window or no channels",
 			rd->path);
 		return -1;
 	}
 	if (!stride_fits(w, chl->num_channels)) {
-		set_err(rd->err, rd->errlen, "cannot read '%s': %lld pixels x %d channels "
+		errbuf_printf(rd->err, rd->errlen, "cannot read '%s': %lld pixels x %d channels "
 			"per line is too many", rd->path, (long long)w, chl->num_channels);
 		return -1;
 	}
 	names = calloc((size_t)chl->num_channels, sizeof(*names));
 	if (!names) {
-		set_err(rd->err, rd->errlen, "cannot read '%s': out of memory", rd->path);
+		errbuf_printf(rd->err, rd->errlen, "cannot read '%s': out of memory", rd->path);
 		return -1;
 	}
 	for (int c = 0; c < chl->num_channels; c++) {
 		const exr_attr_chlist_entry_t *e = &chl->entries[c];
 
 		if (e->x_sampling != 1 || e->y_sampling != 1) {
-			set_err(rd->err, rd->errlen,
+			errbuf_printf(rd->err, rd->errlen,
 				"cannot read '%s': channel '%s' is subsampled, which is not supported",
 				rd->path, e->name.str);
 			goto out;
@@ -458,7 +448,7 @@ static int read_part0(struct reader *rd)
 		/* channels are matched by name, so a damaged list must not repeat one */
 		for (int k = 0; k < c; k++) {
 			if (!strcmp(names[k], names[c])) {
-				set_err(rd->err, rd->errlen,
+				errbuf_printf(rd->err, rd->errlen,
 					"cannot read '%s': channel '%s' appears twice",
 					rd->path, names[c]);
 				goto out;
@@ -469,7 +459,7 @@ static int read_part0(struct reader *rd)
 		char why[200];
 
 		snprintf(why, sizeof(why), "%s", rd->err ? rd->err : "");
-		set_err(rd->err, rd->errlen, "cannot read '%s': %s", rd->path, why);
+		errbuf_printf(rd->err, rd->errlen, "cannot read '%s': %s", rd->path, why);
 		goto out;
 	}
 	if (storage == EXR_STORAGE_SCANLINE)
@@ -501,15 +491,15 @@ int image_read_exr(const char *path, struct image *out, char *err, size_t errlen
 
 	src.fd = open(path, O_RDONLY | O_CLOEXEC);
 	if (src.fd < 0) {
-		set_err(err, errlen, "cannot open '%s': %s", path, strerror(errno));
+		errbuf_printf(err, errlen, "cannot open '%s': %s", path, strerror(errno));
 		return -1;
 	}
 	if (fstat(src.fd, &st)) {
-		set_err(err, errlen, "cannot read '%s': %s", path, strerror(errno));
+		errbuf_printf(err, errlen, "cannot read '%s': %s", path, strerror(errno));
 		goto out;
 	}
 	if (S_ISDIR(st.st_mode)) {
-		set_err(err, errlen, "cannot read '%s': %s", path, strerror(EISDIR));
+		errbuf_printf(err, errlen, "cannot read '%s': %s", path, strerror(EISDIR));
 		goto out;
 	}
 	/* -1 tells the library the size is unknown (a pipe); it then skips checks */
@@ -519,11 +509,11 @@ int image_read_exr(const char *path, struct image *out, char *err, size_t errlen
 		n = pread(src.fd, magic, sizeof(magic), 0);
 	while (n < 0 && errno == EINTR);
 	if (n < 0) {
-		set_err(err, errlen, "cannot read '%s': %s", path, strerror(errno));
+		errbuf_printf(err, errlen, "cannot read '%s': %s", path, strerror(errno));
 		goto out;
 	}
 	if (n != (ssize_t)sizeof(magic) || memcmp(magic, exr_magic, sizeof(magic))) {
-		set_err(err, errlen, "cannot read '%s': not an EXR file", path);
+		errbuf_printf(err, errlen, "cannot read '%s': not an EXR file", path);
 		goto out;
 	}
 
@@ -747,7 +737,7 @@ static int write_fd(int fd, const char *path, const struct image *img, exr_pixel
 
 	for (int c = 0; c < img->nch; c++) {
 		if (!img->names[c][0] || image_channel(img, img->names[c]) != c) {
-			set_err(err, errlen, "cannot write '%s': channel %d has an empty "
+			errbuf_printf(err, errlen, "cannot write '%s': channel %d has an empty "
 				"or repeated name '%s'", path, c, img->names[c]);
 			return -1;
 		}
@@ -818,18 +808,18 @@ static int write_exr(const char *path, const struct image *img, exr_pixel_type_t
 	int fd;
 
 	if (!img || !img->px || !img->names || img->w <= 0 || img->h <= 0 || img->nch <= 0) {
-		set_err(err, errlen, "cannot write '%s': empty image", path);
+		errbuf_printf(err, errlen, "cannot write '%s': empty image", path);
 		return -1;
 	}
 	if (!stride_fits(img->w, img->nch)) {
-		set_err(err, errlen, "cannot write '%s': %d pixels x %d channels per line "
+		errbuf_printf(err, errlen, "cannot write '%s': %d pixels x %d channels per line "
 			"is too many", path, img->w, img->nch);
 		return -1;
 	}
 	len = strlen(path);
 	tmp = malloc(len + sizeof(suffix));
 	if (!tmp) {
-		set_err(err, errlen, "cannot write '%s': out of memory", path);
+		errbuf_printf(err, errlen, "cannot write '%s': out of memory", path);
 		return -1;
 	}
 	memcpy(tmp, path, len);
@@ -837,29 +827,29 @@ static int write_exr(const char *path, const struct image *img, exr_pixel_type_t
 
 	fd = mkstemp(tmp);
 	if (fd < 0) {
-		set_err(err, errlen, "cannot write '%s': %s", path, strerror(errno));
+		errbuf_printf(err, errlen, "cannot write '%s': %s", path, strerror(errno));
 		free(tmp);
 		return -1;
 	}
 	/* mkstemp makes the file 0600; an output image gets the usual 0666 & ~umask */
 	if (fchmod(fd, 0666 & ~current_umask())) {
-		set_err(err, errlen, "cannot write '%s': %s", path, strerror(errno));
+		errbuf_printf(err, errlen, "cannot write '%s': %s", path, strerror(errno));
 		goto fail;
 	}
 	if (write_fd(fd, path, img, type, err, errlen))
 		goto fail;
 	if (fsync(fd)) {
-		set_err(err, errlen, "cannot write '%s': %s", path, strerror(errno));
+		errbuf_printf(err, errlen, "cannot write '%s': %s", path, strerror(errno));
 		goto fail;
 	}
 	if (close(fd)) {
 		fd = -1;
-		set_err(err, errlen, "cannot write '%s': %s", path, strerror(errno));
+		errbuf_printf(err, errlen, "cannot write '%s': %s", path, strerror(errno));
 		goto fail;
 	}
 	fd = -1;
 	if (rename(tmp, path)) {
-		set_err(err, errlen, "cannot rename '%s' to '%s': %s", tmp, path,
+		errbuf_printf(err, errlen, "cannot rename '%s' to '%s': %s", tmp, path,
 			strerror(errno));
 		goto fail;
 	}
@@ -899,7 +889,7 @@ int image_rgb(const struct image *src, const char *what, struct image *out,
 		int y = image_channel(src, "Y");
 
 		if (y < 0) {
-			set_err(err, errlen, "'%s' has no colour channels (needs R, G and B, or Y)", what);
+			errbuf_printf(err, errlen, "'%s' has no colour channels (needs R, G and B, or Y)", what);
 			return -1;
 		}
 		idx[0] = idx[1] = idx[2] = y;

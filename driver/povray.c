@@ -20,6 +20,7 @@
  */
 #define _GNU_SOURCE	/* pipe2, wait4, sched_getaffinity, prctl */
 
+#include "driver/errbuf.h"
 #include "driver/povray.h"
 
 #include <ctype.h>
@@ -53,17 +54,6 @@
 #define POV_TICK_S 0.1		/* longest wait between checks of the children */
 
 extern char **environ;
-
-static void errf(char *err, size_t errlen, const char *fmt, ...)
-{
-	va_list ap;
-
-	if (!err || !errlen)
-		return;
-	va_start(ap, fmt);
-	vsnprintf(err, errlen, fmt, ap);
-	va_end(ap);
-}
 
 /* malloc'd printf; NULL when out of memory. */
 static char *xprintf(const char *fmt, ...)
@@ -196,19 +186,19 @@ static int make_link(const char *workdir, const char *target, const char *suffix
 
 	*link_out = NULL;
 	if (!workdir || !*workdir) {
-		errf(err, errlen, "cannot pass '%s' to povray: the path has a double quote "
+		errbuf_printf(err, errlen, "cannot pass '%s' to povray: the path has a double quote "
 		     "or a non-ASCII byte, and no work directory was given for a link", what);
 		return -1;
 	}
 	if (!path_safe(workdir)) {
-		errf(err, errlen, "cannot use work directory '%s': its own path has a double "
+		errbuf_printf(err, errlen, "cannot use work directory '%s': its own path has a double "
 		     "quote or a non-ASCII byte", workdir);
 		return -1;
 	}
 	link = xprintf("%s/povpress-%016llx%s", workdir, (unsigned long long)fnv1a(target),
 		       suffix);
 	if (!link) {
-		errf(err, errlen, "out of memory");
+		errbuf_printf(err, errlen, "out of memory");
 		return -1;
 	}
 	for (int tries = 0; tries < 2; tries++) {
@@ -233,7 +223,7 @@ static int make_link(const char *workdir, const char *target, const char *suffix
 			break;
 		}
 	}
-	errf(err, errlen, "cannot make link '%s' to '%s': %s", link, what, strerror(errno));
+	errbuf_printf(err, errlen, "cannot make link '%s' to '%s': %s", link, what, strerror(errno));
 	free(link);
 	return -1;
 }
@@ -362,19 +352,19 @@ static int plan_output(const struct pov_job *job, struct cmd *c, char *err, size
 	int rc = -1;
 
 	if (!dir) {
-		errf(err, errlen, "out of memory");
+		errbuf_printf(err, errlen, "out of memory");
 		return -1;
 	}
 	if (!blen || !strcmp(base, ".") || !strcmp(base, "..")) {
-		errf(err, errlen, "cannot write '%s': not a file name", job->output);
+		errbuf_printf(err, errlen, "cannot write '%s': not a file name", job->output);
 		goto out;
 	}
 	if (stat(dir, &st) || (S_ISDIR(st.st_mode) && access(dir, W_OK | X_OK))) {
-		errf(err, errlen, "cannot write '%s': %s", job->output, strerror(errno));
+		errbuf_printf(err, errlen, "cannot write '%s': %s", job->output, strerror(errno));
 		goto out;
 	}
 	if (!S_ISDIR(st.st_mode)) {
-		errf(err, errlen, "cannot write '%s': '%s' is not a directory", job->output, dir);
+		errbuf_printf(err, errlen, "cannot write '%s': '%s' is not a directory", job->output, dir);
 		goto out;
 	}
 	if (path_safe(dir)) {
@@ -383,7 +373,7 @@ static int plan_output(const struct pov_job *job, struct cmd *c, char *err, size
 	} else {
 		real = realpath(dir, NULL);
 		if (!real) {
-			errf(err, errlen, "cannot write '%s': %s", job->output, strerror(errno));
+			errbuf_printf(err, errlen, "cannot write '%s': %s", job->output, strerror(errno));
 			goto out;
 		}
 		if (make_link(job->workdir, real, ".d", dir, &link, err, errlen))
@@ -412,7 +402,7 @@ static int plan_output(const struct pov_job *job, struct cmd *c, char *err, size
 	rc = 0;
 	goto out;
 oom:
-	errf(err, errlen, "out of memory");
+	errbuf_printf(err, errlen, "out of memory");
 out:
 	free(dir);
 	free(odir);
@@ -433,11 +423,11 @@ static int plan_scene(const struct pov_job *job, struct cmd *c, char **iarg, cha
 
 	*iarg = *larg = NULL;
 	if (stat(job->scene, &st) || access(job->scene, R_OK)) {
-		errf(err, errlen, "cannot read scene '%s': %s", job->scene, strerror(errno));
+		errbuf_printf(err, errlen, "cannot read scene '%s': %s", job->scene, strerror(errno));
 		return -1;
 	}
 	if (!S_ISREG(st.st_mode)) {
-		errf(err, errlen, "cannot read scene '%s': not a regular file", job->scene);
+		errbuf_printf(err, errlen, "cannot read scene '%s': not a regular file", job->scene);
 		return -1;
 	}
 	dir = split_path(job->scene, &base);
@@ -448,7 +438,7 @@ static int plan_scene(const struct pov_job *job, struct cmd *c, char **iarg, cha
 	} else {
 		real = realpath(job->scene, NULL);
 		if (!real) {
-			errf(err, errlen, "cannot read scene '%s': %s", job->scene, strerror(errno));
+			errbuf_printf(err, errlen, "cannot read scene '%s': %s", job->scene, strerror(errno));
 			goto out;
 		}
 		if (make_link(job->workdir, real, ".pov", job->scene, iarg, err, errlen))
@@ -465,7 +455,7 @@ static int plan_scene(const struct pov_job *job, struct cmd *c, char **iarg, cha
 	} else {
 		real = realpath(dir, NULL);
 		if (!real) {
-			errf(err, errlen, "cannot read scene '%s': %s", job->scene, strerror(errno));
+			errbuf_printf(err, errlen, "cannot read scene '%s': %s", job->scene, strerror(errno));
 			goto out;
 		}
 		if (make_link(job->workdir, real, ".d", dir, larg, err, errlen))
@@ -478,7 +468,7 @@ static int plan_scene(const struct pov_job *job, struct cmd *c, char **iarg, cha
 	rc = 0;
 	goto out;
 oom:
-	errf(err, errlen, "out of memory");
+	errbuf_printf(err, errlen, "out of memory");
 out:
 	if (rc) {
 		free(*iarg);
@@ -498,39 +488,39 @@ static int cmd_build(const struct pov_job *job, struct cmd *c, char *err, size_t
 
 	memset(c, 0, sizeof(*c));
 	if (!job->scene || !*job->scene || !job->output || !*job->output) {
-		errf(err, errlen, "a render job needs a scene and an output");
+		errbuf_printf(err, errlen, "a render job needs a scene and an output");
 		return -1;
 	}
 	c->scene = job->scene;
 	c->output = job->output;
 	if (job->width < 1 || job->height < 1 || job->width > POV_MAX_SIZE ||
 	    job->height > POV_MAX_SIZE) {
-		errf(err, errlen, "cannot render '%s' at %dx%d: bad image size", job->scene,
+		errbuf_printf(err, errlen, "cannot render '%s' at %dx%d: bad image size", job->scene,
 		     job->width, job->height);
 		return -1;
 	}
 	if (r && (r->x0 < 0 || r->y0 < 0 || r->x0 > r->x1 || r->y0 > r->y1 ||
 		  r->x1 >= job->width || r->y1 >= job->height)) {
-		errf(err, errlen, "cannot render region %d,%d-%d,%d of a %dx%d image", r->x0,
+		errbuf_printf(err, errlen, "cannot render region %d,%d-%d,%d of a %dx%d image", r->x0,
 		     r->y0, r->x1, r->y1, job->width, job->height);
 		return -1;
 	}
 	if (job->threads < 0 || job->threads > POV_MAX_THREADS) {
-		errf(err, errlen, "bad thread count %d", job->threads);
+		errbuf_printf(err, errlen, "bad thread count %d", job->threads);
 		return -1;
 	}
 	for (size_t i = 0; i < job->ndefines; i++) {
 		const struct pov_define *d = &job->defines[i];
 
 		if (!valid_identifier(d->name) || !valid_number(d->value)) {
-			errf(err, errlen, "bad declare '%s=%s': POV-Ray takes an identifier and "
+			errbuf_printf(err, errlen, "bad declare '%s=%s': POV-Ray takes an identifier and "
 			     "a number", d->name ? d->name : "", d->value ? d->value : "");
 			return -1;
 		}
 	}
 	for (size_t i = 0; i < job->nextra; i++) {
 		if (!job->extra[i]) {
-			errf(err, errlen, "extra povray option %zu is missing", i + 1);
+			errbuf_printf(err, errlen, "extra povray option %zu is missing", i + 1);
 			return -1;
 		}
 	}
@@ -563,7 +553,7 @@ static int cmd_build(const struct pov_job *job, struct cmd *c, char *err, size_t
 	free(larg);
 	return 0;
 oom:
-	errf(err, errlen, "out of memory");
+	errbuf_printf(err, errlen, "out of memory");
 fail:
 	free(iarg);
 	free(larg);
@@ -633,7 +623,7 @@ int pov_shell_line(const struct pov_job *job, char **line_out, char *err, size_t
 	cmd_release(&c);
 	if (bad) {
 		free(b.p);
-		errf(err, errlen, "out of memory");
+		errbuf_printf(err, errlen, "out of memory");
 		return -1;
 	}
 	*line_out = b.p;
@@ -659,7 +649,7 @@ int pov_find_binary(const struct pov_job *job, char *path, size_t pathlen, char 
 			return 0;
 		} else
 			e = ENAMETOOLONG;
-		errf(err, errlen, "cannot run '%s'%s: %s", name, how, strerror(e));
+		errbuf_printf(err, errlen, "cannot run '%s'%s: %s", name, how, strerror(e));
 		return -1;
 	}
 	const char *p = getenv("PATH");
@@ -682,7 +672,7 @@ int pov_find_binary(const struct pov_job *job, char *path, size_t pathlen, char 
 		p = colon + 1;
 	}
 	path[0] = '\0';
-	errf(err, errlen, "cannot run '%s'%s: %s (looked in PATH; set POVPRESS_POVRAY to the "
+	errbuf_printf(err, errlen, "cannot run '%s'%s: %s (looked in PATH; set POVPRESS_POVRAY to the "
 	     "binary)", name, how, strerror(e));
 	return -1;
 }
@@ -996,7 +986,7 @@ int pov_signals_catch(char *err, size_t errlen)
 		sa.sa_flags = 0;	/* no SA_RESTART: let poll() return at once */
 		for (int i = 0; i < NCAUGHT; i++) {
 			if (sigaction(caught_signals[i], &sa, &sig_saved[i])) {
-				errf(err, errlen, "cannot catch signal %d: %s", caught_signals[i],
+				errbuf_printf(err, errlen, "cannot catch signal %d: %s", caught_signals[i],
 				     strerror(errno));
 				while (i-- > 0)
 					sigaction(caught_signals[i], &sig_saved[i], NULL);
@@ -1475,7 +1465,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 	for (size_t i = 0; i < njobs; i++)
 		memset(&results[i], 0, sizeof(results[i]));
 	if (!opts || opts->max_jobs < 1) {
-		errf(err, errlen, "a pool needs at least one job slot");
+		errbuf_printf(err, errlen, "a pool needs at least one job slot");
 		return -1;
 	}
 	if (njobs)
@@ -1484,7 +1474,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 	p.pfd = calloc(slots, sizeof(*p.pfd));
 	p.pidx = calloc(slots, sizeof(*p.pidx));
 	if (!p.pj || !p.pfd || !p.pidx) {
-		errf(err, errlen, "out of memory");
+		errbuf_printf(err, errlen, "out of memory");
 		goto out;
 	}
 	/* Everything that can be checked is checked before anything starts. */
@@ -1495,7 +1485,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 			goto out;
 		p.pj[i].bin = strdup(bin);
 		if (!p.pj[i].bin) {
-			errf(err, errlen, "out of memory");
+			errbuf_printf(err, errlen, "out of memory");
 			goto out;
 		}
 	}
@@ -1503,7 +1493,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 	if (p.devnull >= 0)
 		p.devnull = high_fd(p.devnull);
 	if (p.devnull < 0) {
-		errf(err, errlen, "cannot open '/dev/null': %s", strerror(errno));
+		errbuf_printf(err, errlen, "cannot open '/dev/null': %s", strerror(errno));
 		goto out;
 	}
 	if (pov_signals_catch(err, errlen))
