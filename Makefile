@@ -1,5 +1,7 @@
 # povpress build.  `make` builds build/povpress; `make check` runs the unit
-# and end-to-end tests; `make bench` measures analysis throughput.
+# and end-to-end tests; `make bench` measures analysis throughput; `make sweep`
+# measures POV-Ray's own CPU time against error on the bundled scenes
+# (SWEEP_ARGS="--quick scenes/media.pov" passes options to scripts/sweep.sh).
 
 CC      ?= cc
 CFLAGS  ?= -O3 -g
@@ -20,7 +22,7 @@ UNIT_SRC = $(wildcard tests/test_*.c)
 UNIT_BIN = $(UNIT_SRC:tests/%.c=$(BUILD)/tests/%)
 TOOL_BIN = $(BUILD)/tests/gen_image $(BUILD)/bench/bench_analyze
 
-.PHONY: all check unit e2e bench clean deps demo
+.PHONY: all check unit e2e bench clean deps demo sweep
 .SECONDARY:
 all: $(BUILD)/povpress
 
@@ -47,6 +49,12 @@ $(BUILD)/bench/bench_analyze: $(BUILD)/scripts/bench_analyze.o $(REG_OBJ) | $(BU
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
 
+# A helper of scripts/sweep.sh: box-average an EXR (see scripts/boxdown.c).
+$(BUILD)/tools/boxdown: $(BUILD)/scripts/boxdown.o $(BUILD)/driver/downsample.o \
+		$(BUILD)/driver/image.o $(BUILD)/driver/errbuf.o
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -o $@ $^ $(EXR_LIBS) $(LDLIBS)
+
 deps: $(BUILD)/.deps
 
 unit: $(UNIT_BIN)
@@ -62,6 +70,9 @@ bench: $(BUILD)/bench/bench_analyze
 
 demo: $(BUILD)/povpress
 	scripts/demo.sh $(BUILD)
+
+sweep: $(BUILD)/povpress $(BUILD)/tools/boxdown
+	BUILD=$(BUILD) scripts/sweep.sh $(SWEEP_ARGS)
 
 clean:
 	rm -rf $(BUILD)

@@ -1,0 +1,568 @@
+#!/usr/bin/env bash
+# How POV-Ray alone trades CPU time for error on the bundled scenes, with its
+# two ways of adding samples per pixel: its own antialiasing (+AM1, +AM2) and
+# resolution scaling (render at s*W x s*H with antialiasing off, box-average
+# each s x s block).  The adaptive renderer uses it to choose how to add
+# samples, and the benchmark as its POV-Ray-alone baseline.
+#
+# usage: scripts/sweep.sh [--quick] [--size WxH] [SCENE.pov ...]
+#        make sweep [SWEEP_ARGS="--quick scenes/media.pov"]
+#
+# Default: every scenes/*.pov at 160x120.  Needs build/povpress and
+# build/tools/boxdown (make sweep builds both; $BUILD names another build
+# directory), povray and gnuplot.
+#
+# Reference.  Per scene and size, the scene at its default knobs rendered by
+# resolution scaling: +W(16 W) +H(16 H), antialiasing off, box-averaged by
+# boxdown (256 samples per pixel).  A second one at scale 12 checks it:
+# relMSE(ref16, ref12) is printed for each scene.  --quick uses scales 8 and
+# 6.  References are rendered with one thread per POV-Ray process (so each
+# is bit-reproducible), two processes at a time (one per core), and cached
+# outside the repository in ${POVPRESS_CACHE:-$HOME/.cache/povpress}/ref/,
+# under a hash of the scene file's contents, the size, the scale, the
+# settings and POV-Ray's version: editing a scene makes a new reference.
+# (The hash does not cover files the scene includes.)
+#
+# Sweep.  One POV-Ray process per run, +WT1, one run at a time, so that CPU
+# times are comparable:
+#   noaa   no antialiasing (-A)
+#   am1    +AM1 +A{0.3,0.1,0.03,0.01,0.0} +R{2,3,4} +J
+#   am2    +AM2, the same thresholds and depths, +J
+#   scale  s = 1, 2, 3, 4: +W(s W) +H(s H) -A, then boxdown
+# (--quick: thresholds 0.3, 0.03, 0.0 and depths 2, 3.)  Every call is
+#   povray -D -GA +FE +WT1 +W.. +H.. +O.. +I<scene> +L<scene's dir> [options]
+# with the paths in double quotes (POV-Ray splits unquoted ones at spaces).
+# Each run records the CPU seconds (user + system) and wall seconds of the
+# POV-Ray process, from bash's `time` (millisecond resolution; GNU time
+# prints only hundredths, too coarse for renders of 0.03 s), and relMSE and
+# PSNR against the reference from `povpress compare`.  The box-averaging of
+# scale runs is not counted (a few milliseconds).
+#
+# Output, in $BUILD/sweep/:
+#   sweep.csv        scene,method,setting,cpu_s,wall_s,relmse,psnr
+#   <scene>.png      relMSE against CPU seconds, log-log, one series per
+#                    method, and the lower envelope (the best relMSE any run
+#                    reaches within each CPU time)
+#   summary.md       the tables printed at the end, and notes
+#   <scene>/         the runs' images (W x H) and POV-Ray logs
+# Progress goes to stderr; the summary tables to stdout.  Interrupted (INT,
+# TERM, HUP), it stops the POV-Ray processes it started (each runs in its
+# own process group) and leaves no partial reference in the cache.
+set -euo pipefail
+
+usage() {
+	sed -n 's/^# \{0,1\}//; 8,9p' "$0"
+}
+
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+BUILD=${BUILD:-$ROOT/build}
+POVPRESS=$BUILD/povpress
+BOXDOWN=$BUILD/tools/boxdown
+CACHE=${POVPRESS_CACHE:-$HOME/.cache/povpress}/ref
+OUT=$BUILD/sweep
+
+quick=0
+size=160x120
+scenes=()
+while (($#)); do
+	case $1 in
+	--quick) quick=1 ;;
+	--size)
+		[[ $# -ge 2 ]] || { echo "sweep: --size needs WxH" >&2; exit 2; }
+		size=$2
+		shift
+		;;
+	--size=*) size=${1#--size=} ;;
+	-h | --help) usage; exit 0 ;;
+	--) shift; scenes+=("$@"); break ;;
+	-*) echo "sweep: unknown option '$1'" >&2; usage >&2; exit 2 ;;
+	*) scenes+=("$1") ;;
+	esac
+	shift
+done
+if [[ ! $size =~ ^([1-9][0-9]{0,4})x([1-9][0-9]{0,4})$ ]]; then
+	echo "sweep: invalid size '$size': expected WxH, as 160x120" >&2
+	exit 2
+fi
+W=${BASH_REMATCH[1]}
+H=${BASH_REMATCH[2]}
+((${#scenes[@]})) || scenes=("$ROOT"/scenes/*.pov)
+
+if ((quick)); then
+	REF_S=8 CHK_S=6
+	THRESHOLDS=(0.3 0.03 0.0)
+	DEPTHS=(2 3)
+else
+	REF_S=16 CHK_S=12
+	THRESHOLDS=(0.3 0.1 0.03 0.01 0.0)
+	DEPTHS=(2 3 4)
+fi
+SCALES=(1 2 3 4)
+NPAR=$(nproc 2>/dev/null || echo 2)
+BUDGETS=(2 4 8)
+
+die() {
+	echo "sweep: $*" >&2
+	exit 1
+}
+
+for t in "$POVPRESS" "$BOXDOWN"; do
+	[[ -x $t ]] || die "missing '$t': run 'make sweep'"
+done
+command -v povray >/dev/null || die "povray is not installed (scripts/install-deps.sh)"
+command -v gnuplot >/dev/null || die "gnuplot is not installed (scripts/install-deps.sh)"
+# POV-Ray takes a path in double quotes, which it cannot itself contain, and
+# mangles bytes outside ASCII.
+check_path() {
+	local LC_ALL=C
+	[[ $1 != *'"'* && ! $1 =~ [^\ -~] ]] ||
+		die "cannot pass '$1' to povray: the path has a double quote or a byte outside printable ASCII"
+}
+names=()
+declare -A seen_name=()
+for i in "${!scenes[@]}"; do
+	sc=${scenes[$i]}
+	[[ -f $sc && -r $sc ]] || die "cannot read scene '$sc'"
+	sc=$(cd "$(dirname "$sc")" && pwd)/$(basename "$sc")
+	check_path "$sc"
+	scenes[i]=$sc
+	name=$(basename "$sc" .pov)
+	[[ -z ${seen_name[$name]:-} ]] || die "two scenes are called '$name'"
+	[[ $name != *,* ]] || die "cannot name scene '$name' in a CSV: it has a comma"
+	seen_name[$name]=1
+	names+=("$name")
+done
+POV_VERSION=$(povray --version 2>&1 | grep -m1 '^POV-Ray' || true)
+[[ -n $POV_VERSION ]] || die "cannot tell povray's version ('povray --version')"
+REF_SETTINGS="povray -D -GA +FE +WT1 -A at scale s, box-averaged by boxdown"
+
+mkdir -p "$CACHE" "$OUT"
+OUT=$(cd "$OUT" && pwd)
+check_path "$OUT"
+check_path "$CACHE"
+RUNTMP=$(mktemp -d "$CACHE/.sweep.XXXXXX")
+
+# ---- jobs: every POV-Ray process runs in a background job with its own
+# process group (job control is on only while it starts), so that an
+# interruption can stop the job's whole group.
+
+declare -A JOBS=()
+JOB=
+
+job_start() { # COMMAND...: start it as a job in its own process group; JOB=pid
+	set -m
+	"$@" &
+	JOB=$!
+	set +m
+	JOBS[$JOB]=1
+}
+
+job_wait() { # PID: wait for the job; returns its status
+	local rc=0
+	wait "$1" || rc=$?
+	unset "JOBS[$1]"
+	return "$rc"
+}
+
+group_alive() { # PGID: is a process of that group still running (not a zombie)?
+	ps -e -o pgid=,stat= | awk -v g="$1" '$1 == g && $2 !~ /^Z/ { f = 1 } END { exit !f }'
+}
+
+stop_jobs() { # TERM each job's process group, KILL it after 3 s, reap it
+	local pid t sig=TERM
+	((${#JOBS[@]})) || return 0
+	for pid in "${!JOBS[@]}"; do
+		kill -TERM -- "-$pid" 2>/dev/null || true
+	done
+	for t in $(seq 40); do
+		for pid in "${!JOBS[@]}"; do
+			group_alive "$pid" || unset "JOBS[$pid]"
+		done
+		((${#JOBS[@]})) || break
+		if ((t == 30)); then
+			sig=KILL
+			for pid in "${!JOBS[@]}"; do
+				kill -KILL -- "-$pid" 2>/dev/null || true
+			done
+		fi
+		sleep 0.1
+	done
+	wait 2>/dev/null || true
+	((${#JOBS[@]} == 0)) || echo "sweep: could not stop process group(s) ${!JOBS[*]}" >&2
+	[[ $sig == TERM ]] || echo "sweep: POV-Ray needed SIGKILL" >&2
+	JOBS=()
+}
+
+on_signal() {
+	trap '' INT TERM HUP
+	echo >&2
+	echo "sweep: interrupted; stopping POV-Ray" >&2
+	stop_jobs
+	rm -f "$OUT"/*/*.pov-state
+	exit "$1"
+}
+on_exit() {
+	stop_jobs
+	rm -rf "$RUNTMP"
+}
+trap 'on_signal 130' INT
+trap 'on_signal 143' TERM
+trap 'on_signal 129' HUP
+trap on_exit EXIT
+
+# timed_povray TIMEFILE LOG ARGS...: run povray ARGS, logging its output to
+# LOG and writing "user sys wall" seconds to TIMEFILE.  Runs inside a job.
+timed_povray() {
+	local tf=$1 log=$2 TIMEFORMAT='%3U %3S %3R'
+	shift 2
+	{ time povray "$@" </dev/null >"$log" 2>&1; } 2>"$tf"
+}
+
+# pov_args W H OUT SCENE: the fixed part of every POV-Ray call, in POV.
+pov_args() {
+	POV=(-D -GA +FE +WT1 "+W$1" "+H$2" "+O\"$3\"" "+I\"$4\"" "+L\"$(dirname "$4")\"")
+}
+
+# ---- references
+
+ref_path() { # SCENE S: the cache file of the scene's reference at scale S
+	local key
+	key=$({
+		echo "povpress sweep reference 1"
+		echo "size ${W}x$H"
+		echo "scale $2"
+		echo "settings $REF_SETTINGS"
+		echo "version $POV_VERSION"
+		sha256sum <"$1"
+	} | sha256sum | cut -c1-16)
+	echo "$CACHE/$(basename "$1" .pov)-${W}x$H-s$2-$key.exr"
+}
+
+ref_job() { # SCENE S DEST: render the reference into DEST (runs inside a job)
+	local scene=$1 s=$2 dest=$3 tmp
+	tmp=$(mktemp -d "$RUNTMP/ref.XXXXXX")
+	pov_args $((s * W)) $((s * H)) "$tmp/hi.exr" "$scene"
+	if ! timed_povray "$tmp/time" "$tmp/log" "${POV[@]}" -A; then
+		echo "sweep: povray failed on '$scene' at scale $s:" >&2
+		tail -n 15 "$tmp/log" >&2
+		return 1
+	fi
+	"$BOXDOWN" "$tmp/hi.exr" "$s" "$tmp/ref.exr" || return 1
+	mv "$tmp/time" "${dest%.exr}.time"
+	mv "$tmp/ref.exr" "$dest"	# last: a reference in the cache is complete
+	rm -rf "$tmp"
+}
+
+T0=$EPOCHREALTIME
+elapsed() {
+	awk -v a="$T0" -v b="$EPOCHREALTIME" 'BEGIN { printf "%.0f s", b - a }'
+}
+
+declare -A REF REFCHK REFDIFF JOBDESC
+pending=()
+for s in "$REF_S" "$CHK_S"; do	# the larger first: better packing on the cores
+	for sc in "${scenes[@]}"; do
+		p=$(ref_path "$sc" "$s")
+		if ((s == REF_S)); then REF[$sc]=$p; else REFCHK[$sc]=$p; fi
+		[[ -s $p ]] || pending+=("$s|$sc|$p")
+	done
+done
+echo "sweep: ${#scenes[@]} scene(s) at ${W}x$H; references (scales $REF_S and $CHK_S) in $CACHE" >&2
+if ((${#pending[@]})); then
+	echo "sweep: rendering ${#pending[@]} reference(s), $NPAR at a time" >&2
+fi
+reap_one() {
+	local pid rc=0 t
+	wait -n -p pid "${!JOBS[@]}" || rc=$?
+	unset "JOBS[$pid]"
+	((rc == 0)) || die "reference ${JOBDESC[$pid]} failed"
+	read -r t < <(awk 'END { printf "%.1f\n", $1 + $2 }' "${JOBDESC[$pid]##*|}")
+	echo "sweep: reference ${JOBDESC[$pid]%%|*} done ($t s CPU; $(elapsed))" >&2
+}
+for item in "${pending[@]}"; do
+	IFS='|' read -r s sc p <<<"$item"
+	while ((${#JOBS[@]} >= NPAR)); do reap_one; done
+	job_start ref_job "$sc" "$s" "$p"
+	JOBDESC[$JOB]="$(basename "$sc" .pov) s=$s ($((s * W))x$((s * H)))|${p%.exr}.time"
+	echo "sweep: reference $(basename "$sc" .pov) s=$s started" >&2
+done
+while ((${#JOBS[@]})); do reap_one; done
+
+for sc in "${scenes[@]}"; do
+	REFDIFF[$sc]=$("$POVPRESS" compare "${REF[$sc]}" "${REFCHK[$sc]}" |
+		sed -n 's/^relmse: //p')
+	echo "sweep: $(basename "$sc" .pov): relMSE(ref$REF_S, ref$CHK_S) = ${REFDIFF[$sc]}" >&2
+done
+
+# ---- the sweep
+
+CSV=$OUT/sweep.csv
+echo "scene,method,setting,cpu_s,wall_s,relmse,psnr" >"$CSV.tmp"
+runs=("noaa|-|noaa|-A")
+for m in 1 2; do
+	for a in "${THRESHOLDS[@]}"; do
+		for r in "${DEPTHS[@]}"; do
+			runs+=("am$m|+A$a +R$r|am$m-A$a-R$r|+AM$m +A$a +R$r +J")
+		done
+	done
+done
+for s in "${SCALES[@]}"; do
+	runs+=("scale|$s|scale$s|-A")
+done
+total=$((${#scenes[@]} * ${#runs[@]}))
+k=0
+for i in "${!scenes[@]}"; do
+	sc=${scenes[$i]}
+	name=${names[$i]}
+	dir=$OUT/$name
+	rm -rf "$dir"
+	mkdir -p "$dir"
+	for run in "${runs[@]}"; do
+		IFS='|' read -r method setting tag opts <<<"$run"
+		k=$((k + 1))
+		s=1
+		[[ $method == scale ]] && s=$setting
+		img=$dir/$tag.exr
+		render=$img
+		((s == 1)) || render=$dir/$tag-hi.exr
+		pov_args $((s * W)) $((s * H)) "$render" "$sc"
+		# shellcheck disable=SC2086 # opts is a list of POV-Ray options
+		job_start timed_povray "$dir/$tag.time" "$dir/$tag.log" "${POV[@]}" $opts
+		if ! job_wait "$JOB"; then
+			tail -n 15 "$dir/$tag.log" >&2
+			die "povray failed on '$sc' ($method $setting); log in $dir/$tag.log"
+		fi
+		if ((s > 1)); then
+			"$BOXDOWN" "$render" "$s" "$img" || die "cannot box-average '$render'"
+			rm -f "$render"
+		fi
+		read -r u sy wall < <(tail -n 1 "$dir/$tag.time")
+		cpu=$(awk -v u="$u" -v s="$sy" 'BEGIN { printf "%.3f", u + s }')
+		cmp=$("$POVPRESS" compare "$img" "${REF[$sc]}") || die "cannot compare '$img'"
+		relmse=$(sed -n 's/^relmse: //p' <<<"$cmp")
+		psnr=$(sed -n 's/^psnr: //p' <<<"$cmp")
+		echo "$name,$method,$setting,$cpu,$wall,$relmse,$psnr" >>"$CSV.tmp"
+		printf 'sweep: [%d/%d] %s %s %s: %s s CPU, %s s wall, relMSE %s (%s)\n' \
+			"$k" "$total" "$name" "$method" "$setting" "$cpu" "$wall" "$relmse" \
+			"$(elapsed)" >&2
+	done
+done
+mv "$CSV.tmp" "$CSV"
+
+# ---- plots
+
+TERM_PNG=png
+gnuplot -e 'set terminal pngcairo' 2>/dev/null && TERM_PNG=pngcairo
+for i in "${!scenes[@]}"; do
+	sc=${scenes[$i]}
+	name=${names[$i]}
+	pd=$RUNTMP/plot-$name
+	mkdir -p "$pd"
+	for m in noaa am1 am2 scale; do
+		awk -F, -v n="$name" -v m="$m" '$1 == n && $2 == m { print $4, $6, $3 }' \
+			"$CSV" >"$pd/$m.dat"
+	done
+	# the lower envelope: the best relMSE reached at or below each CPU time
+	awk -F, -v n="$name" '$1 == n { print $4, $6 }' "$CSV" | sort -g -k1,1 |
+		awk 'NR == 1 || $2 < best { best = $2; print $1, best } { last = $1 }
+		     END { print last, best }' >"$pd/env.dat"
+	gnuplot <<-EOF
+		set terminal $TERM_PNG size 900,640
+		set output '$OUT/$name.png'
+		set title "$name.pov at ${W}x$H: POV-Ray alone, one thread" noenhanced
+		set xlabel 'CPU seconds of the POV-Ray process'
+		set ylabel 'relMSE against the reference ($((REF_S * REF_S)) samples per pixel)'
+		set logscale xy
+		set format y '%.0e'
+		set grid
+		set key outside right top
+		plot '$pd/env.dat' using 1:2 with steps lw 2 lc rgb 'black' title 'lower envelope', \
+			${REFDIFF[$sc]} with lines dt 2 lc rgb 'gray40' title 'ref$REF_S vs ref$CHK_S', \
+			'$pd/noaa.dat' using 1:2 with points pt 7 ps 1.6 lc rgb 'black' title 'no AA', \
+			'$pd/am1.dat' using 1:2 with points pt 6 ps 1.2 lc rgb '#1f77b4' title '+AM1', \
+			'$pd/am2.dat' using 1:2 with points pt 4 ps 1.2 lc rgb '#d62728' title '+AM2', \
+			'$pd/scale.dat' using 1:2 with linespoints pt 9 ps 1.5 lc rgb '#2ca02c' title 'scaling s=${SCALES[0]}..${SCALES[-1]}', \\
+			'$pd/scale.dat' using 1:2:(sprintf('s=%d', \$3)) with labels offset 0,1.2 tc rgb '#2ca02c' notitle
+	EOF
+done
+
+# ---- summary
+
+# One line per scene: name, no-AA cpu and relmse, then for each budget k the
+# best AA relmse and setting and the best scaling relmse and setting within
+# k x no-AA cpu, then the best AA overall (relmse, cpu, setting), the relmse
+# of scale 1 and of the largest scale, the median CPU time of the AA runs
+# and the best relmse of the AA runs that cost no more than it.  The no-AA
+# CPU time is the mean of the noaa and scale 1 runs, which are the same
+# render: a single measurement of a 0.05 s render is off by up to 25%.
+summarize() {
+	awk -F, -v budgets="${BUDGETS[*]}" -v smax="${SCALES[-1]}" '
+	NR > 1 {
+		if (!($1 in seen)) { seen[$1] = 1; order[++ns] = $1 }
+		n = ++cnt[$1]; M[$1, n] = $2; S[$1, n] = $3; C[$1, n] = $4; R[$1, n] = $6
+		if ($2 == "noaa") { ncpu[$1] += $4 / 2; nrel[$1] = $6 }
+		if ($2 == "scale" && $3 == 1) { ncpu[$1] += $4 / 2; s1[$1] = $6 }
+		if ($2 == "scale" && $3 == smax) sm[$1] = $6
+	}
+	END {
+		nb = split(budgets, B, " ")
+		for (i = 1; i <= ns; i++) {
+			sc = order[i]
+			line = sc "\t" sprintf("%.3f", ncpu[sc]) "\t" nrel[sc]
+			for (b = 1; b <= nb; b++) {
+				lim = B[b] * ncpu[sc]
+				ba = ""; bs = ""; sa = "-"; ss = "-"
+				for (j = 1; j <= cnt[sc]; j++) {
+					if (C[sc, j] > lim) continue
+					if (M[sc, j] ~ /^am/ && (ba == "" || R[sc, j] < ba)) {
+						ba = R[sc, j]; sa = M[sc, j] " " S[sc, j]
+					}
+					if (M[sc, j] == "scale" && (bs == "" || R[sc, j] < bs)) {
+						bs = R[sc, j]; ss = "s=" S[sc, j]
+					}
+				}
+				line = line "\t" (ba == "" ? "-" : ba) "\t" sa "\t" \
+					(bs == "" ? "-" : bs) "\t" ss
+			}
+			# the best AA run, and the best of the cheaper half of the AA runs
+			bo = ""; na = 0
+			for (j = 1; j <= cnt[sc]; j++)
+				if (M[sc, j] ~ /^am/) {
+					ac[++na] = C[sc, j]
+					if (bo == "" || R[sc, j] < bo) {
+						bo = R[sc, j]; bc = C[sc, j]; bset = M[sc, j] " " S[sc, j]
+					}
+				}
+			for (a = 2; a <= na; a++)	# insertion sort of the AA CPU times
+				for (q = a; q > 1 && ac[q - 1] > ac[q]; q--) {
+					t = ac[q]; ac[q] = ac[q - 1]; ac[q - 1] = t
+				}
+			med = ac[int((na + 1) / 2)]; bh = ""
+			for (j = 1; j <= cnt[sc]; j++)
+				if (M[sc, j] ~ /^am/ && C[sc, j] <= med && (bh == "" || R[sc, j] < bh))
+					bh = R[sc, j]
+			print line "\t" bo "\t" bc "\t" bset "\t" s1[sc] "\t" sm[sc] "\t" \
+				med "\t" bh
+		}
+	}' "$CSV"
+}
+
+g3() { awk -v x="$1" 'BEGIN { if (x == "-" || x == "") print "-"; else printf "%.3g", x }'; }
+winner() { # AA SCALE: which is lower, and by how much
+	awk -v a="$1" -v s="$2" 'BEGIN {
+		if (a == "-" && s == "-") print "-"
+		else if (a == "-") print "no AA run fits"
+		else if (s == "-") print "AA"
+		else if (a + 0 < s + 0) printf "AA %.1fx\n", (a > 0 ? s / a : 0)
+		else if (s + 0 < a + 0) printf "scaling %.1fx\n", (s > 0 ? a / s : 0)
+		else print "tie"
+	}'
+}
+
+times >"$RUNTMP/times"	# here, not in a subshell: the CPU time of the children
+TOOK="$(elapsed) wall and $(awk 'NR == 2 {
+	split($1, u, /[ms]/); split($2, s, /[ms]/)
+	printf "%.0f s", u[1] * 60 + u[2] + s[1] * 60 + s[2] }' "$RUNTMP/times") CPU (all
+processes; ${#pending[@]} of the $((2 * ${#scenes[@]})) references rendered in this run)"
+SUM=$OUT/summary.md.tmp
+mode=full
+((quick)) && mode=quick
+{
+	echo "# POV-Ray alone: CPU time against error"
+	echo
+	echo "\`scripts/sweep.sh\` ($mode mode), $(date -u '+%Y-%m-%d %H:%M UTC'), $POV_VERSION,"
+	echo "$(nproc) CPUs ($(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)), at ${W}x$H."
+	echo
+	echo "Every run is one POV-Ray process with \`+WT1\`; CPU is its user + system seconds."
+	echo "The reference is the scene at its default knobs by resolution scaling at"
+	echo "s = $REF_S ($((REF_S * REF_S)) samples per pixel, antialiasing off, box-averaged); ref$CHK_S is"
+	echo "the same at s = $CHK_S. Budgets are multiples of the no-AA run's CPU time; \"AA\" is"
+	echo "the best \`+AM1\`/\`+AM2\` run (thresholds ${THRESHOLDS[*]}, depths ${DEPTHS[*]}, \`+J\`)"
+	echo "within the budget, \"scaling\" the best of s = ${SCALES[*]} within it (s = 1 is the"
+	echo "no-AA render); the winner column says by what factor it has the lower relMSE."
+	echo "Data: \`sweep.csv\`; plots: \`<scene>.png\`."
+	echo
+	echo "The no-AA CPU time is the mean of the noaa and s = 1 runs (the same render"
+	echo "twice): single measurements of renders this short vary by up to 25%, and"
+	echo "longer ones vary too, so treat a winner by less than about 1.5x as a tie."
+	echo "The reference's own error is a floor under every figure: if it shrinks as"
+	echo "1/s^2 (noise) or 1/s^3 (aliasing of edges at random angles), ref$REF_S's own relMSE"
+	echo "is about a third of relMSE(ref$REF_S, ref$CHK_S)."
+	echo
+	printf '| scene | relMSE(ref%s, ref%s) | no-AA CPU s | no-AA relMSE |' "$REF_S" "$CHK_S"
+	for b in "${BUDGETS[@]}"; do printf ' %sx: AA | %sx: scaling | %sx: winner |' "$b" "$b" "$b"; done
+	echo
+	printf '|---|---|---|---|'
+	for b in "${BUDGETS[@]}"; do printf -- '---|---|---|'; done
+	echo
+} >"$SUM"
+
+notes=()
+echo
+echo "relMSE against the reference; AA = best +AM1/+AM2 run, scaling = best s within the budget:"
+printf '%-18s %9s %6s %8s' scene "ref$REF_S~$CHK_S" "noAA s" noAA
+for b in "${BUDGETS[@]}"; do printf ' | %-8s %-8s %-12s' "${b}x: AA" scaling winner; done
+echo
+while IFS=$'\t' read -r name ncpu nrel rest; do
+	sc=
+	for i in "${!names[@]}"; do [[ ${names[$i]} == "$name" ]] && sc=${scenes[$i]}; done
+	IFS='|' read -r -a f <<<"${rest//$'\t'/|}"
+	rd=${REFDIFF[$sc]}
+	printf '%-18s %9s %6s %8s' "$name" "$(g3 "$rd")" "$ncpu" "$(g3 "$nrel")"
+	row="| $name | $(g3 "$rd") | $ncpu | $(g3 "$nrel") |"
+	for b in "${!BUDGETS[@]}"; do
+		aa=${f[$((4 * b))]} aas=${f[$((4 * b + 1))]} sr=${f[$((4 * b + 2))]} ss=${f[$((4 * b + 3))]}
+		w=$(winner "$aa" "$sr")
+		printf ' | %-8s %-8s %-12s' "$(g3 "$aa")" "$(g3 "$sr")" "$w"
+		row+=" $(g3 "$aa") ($aas) | $(g3 "$sr") ($ss) | $w |"
+	done
+	echo
+	echo "$row" >>"$SUM"
+	nb=${#BUDGETS[@]}
+	bo=${f[$((4 * nb))]} bc=${f[$((4 * nb + 1))]} bset=${f[$((4 * nb + 2))]}
+	s1=${f[$((4 * nb + 3))]} sm=${f[$((4 * nb + 4))]}
+	amed=${f[$((4 * nb + 5))]} bhalf=${f[$((4 * nb + 6))]}
+	# Notes the data call for: a reference not converged, a method that does not.
+	n=$(awk -v rd="$rd" -v s1="$s1" -v sm="$sm" -v bo="$bo" -v bc="$bc" -v bset="$bset" \
+		-v amed="$amed" -v bhalf="$bhalf" -v r="$REF_S" -v c="$CHK_S" -v smax="${SCALES[-1]}" -v name="$name" '
+	function g(x) { return sprintf("%.3g", x) }
+	BEGIN {
+		if (s1 < 1e-6) {
+			printf "%s: no visible error at one sample per pixel (relMSE %s): more samples buy nothing.\n", name, g(s1)
+			exit
+		}
+		# independent noise: relMSE(ref_r, ref_c) ~ relMSE(1 spp) (1/r^2 + 1/c^2)
+		expect = s1 * (1 / (r * r) + 1 / (c * c))
+		if (rd > 4 * expect)
+			printf "%s: the references disagree (relMSE %s) %.0fx more than noise averaging as 1/spp would leave (%s): some of its error does not average out under resolution scaling, and no figure much below %s is meaningful.\n", name, g(rd), rd / expect, g(expect), g(rd)
+		if (sm > s1 / smax)
+			printf "%s: resolution scaling converges slowly: scale %d (%d spp) divides relMSE by only %.1f (from %s to %s).\n", name, smax, smax * smax, s1 / sm, g(s1), g(sm)
+		if (bo > sm)
+			printf "%s: no antialiasing run reaches scale %d (relMSE %s, %d spp); the best, %s at %s s CPU, stops at %s.\n", name, smax, g(sm), smax * smax, bset, bc, g(bo)
+		if (bhalf < 1.5 * bo)
+			printf "%s: antialiasing stops improving: the AA runs above %s s CPU (the median) reach %s, the cheaper ones already %s.\n", name, amed, g(bo), g(bhalf)
+		if (bo < 4 * rd || sm < 4 * rd)
+			printf "%s: the best figures (AA %s, scale %d %s) are within 4x of relMSE(ref%d, ref%d) = %s (the reference'"'"'s own relMSE is about a third of that): they partly measure the reference.\n", name, g(bo), smax, g(sm), r, c, g(rd)
+	}')
+	[[ -z $n ]] || mapfile -t -O "${#notes[@]}" notes <<<"$n"
+done < <(summarize)
+
+{
+	echo
+	if ((${#notes[@]})); then
+		echo "Notes (found by the script in the data):"
+		echo
+		for n in "${notes[@]}"; do echo "- $n"; done
+		echo
+	fi
+	echo "The sweep took $TOOK."
+} >>"$SUM"
+mv "$SUM" "$OUT/summary.md"
+
+if ((${#notes[@]})); then
+	echo
+	printf '%s\n' "${notes[@]}"
+fi
+echo
+echo "sweep: wrote $CSV, $OUT/summary.md and ${#scenes[@]} plot(s) in $OUT" >&2
+echo "sweep: took ${TOOK//$'\n'/ }" >&2
