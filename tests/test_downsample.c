@@ -17,6 +17,7 @@
 
 #include "driver/downsample.h"
 #include "driver/image.h"
+#include "tests/testutil.h"
 
 static const char *const rgb_names[] = { "R", "G", "B" };
 
@@ -31,15 +32,6 @@ static void make_rgb(struct image *img, int w, int h)
 	char err[256];
 
 	assert_int_equal(image_init(img, w, h, 3, rgb_names, err, sizeof(err)), 0);
-}
-
-static void assert_zeroed(const struct image *img)
-{
-	assert_null(img->px);
-	assert_null(img->names);
-	assert_int_equal(img->w, 0);
-	assert_int_equal(img->h, 0);
-	assert_int_equal(img->nch, 0);
 }
 
 /* Blocks of different constant colours: means are the constants, variances 0. */

@@ -25,34 +25,8 @@
 #include <unistd.h>
 
 #include "driver/image.h"
+#include "tests/testutil.h"
 
-static char scratch_dir[64];
-
-/* scratch_dir/name in buf */
-static const char *scratch(char *buf, size_t len, const char *name)
-{
-	int n = snprintf(buf, len, "%s/%s", scratch_dir, name);
-
-	assert_true(n > 0 && (size_t)n < len);
-	return buf;
-}
-
-/* Run a shell command; returns its exit status, or -1 if it did not exit. */
-static int run(const char *fmt, ...)
-{
-	char cmd[2048];
-	va_list ap;
-	int n, st;
-
-	va_start(ap, fmt);
-	n = vsnprintf(cmd, sizeof(cmd), fmt, ap);
-	va_end(ap);
-	assert_true(n > 0 && (size_t)n < sizeof(cmd));
-	st = system(cmd);
-	if (st == -1 || !WIFEXITED(st))
-		return -1;
-	return WEXITSTATUS(st);
-}
 
 static int setup_dir(void **state)
 {
@@ -151,15 +125,6 @@ static void assert_err_names(const char *err, const char *path)
 {
 	if (!strstr(err, path))
 		fail_msg("message \"%s\" does not name '%s'", err, path);
-}
-
-static void assert_zeroed(const struct image *img)
-{
-	assert_null(img->px);
-	assert_null(img->names);
-	assert_int_equal(img->w, 0);
-	assert_int_equal(img->h, 0);
-	assert_int_equal(img->nch, 0);
 }
 
 /* Count directory entries whose name contains part. */

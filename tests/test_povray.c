@@ -32,36 +32,11 @@
 
 #include "driver/image.h"
 #include "driver/povray.h"
+#include "tests/testutil.h"
 
 #define DATA "tests/data/povray/"
 
-static char scratch_dir[96];
 static char fake_bin[PATH_MAX];
-
-static const char *scratch(char *buf, size_t len, const char *name)
-{
-	int n = snprintf(buf, len, "%s/%s", scratch_dir, name);
-
-	assert_true(n > 0 && (size_t)n < len);
-	return buf;
-}
-
-/* Run a shell command; its exit status, or -1 if it did not exit. */
-static int run(const char *fmt, ...)
-{
-	char cmd[4096];
-	va_list ap;
-	int n, st;
-
-	va_start(ap, fmt);
-	n = vsnprintf(cmd, sizeof(cmd), fmt, ap);
-	va_end(ap);
-	assert_true(n > 0 && (size_t)n < sizeof(cmd));
-	st = system(cmd);
-	if (st == -1 || !WIFEXITED(st))
-		return -1;
-	return WEXITSTATUS(st);
-}
 
 static void write_file(const char *path, const char *text)
 {
