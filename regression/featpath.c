@@ -32,15 +32,21 @@ enum { HT, HTU, HTU2, HQ, HQU, HQU2, NHK };
 /* The spatial columns as exponents (i, j) of u^i v^j. */
 static const int ex[NSP] = { 0, 1, 0, 2, 1, 0 }, ey[NSP] = { 0, 0, 1, 0, 1, 2 };
 
+#define MAXPLANES (LPR_MAXCH + LPR_MAXFEAT + LPR_MAXFEAT * (LPR_MAXFEAT + 1) / 2 + \
+		   LPR_MAXFEAT * LPR_MAXCH)
+
 struct layout {
 	int nch, nf, nff;
 	/* planes: nch colours, nf features, nff feature products, nf*nch
 	 * feature-colour products */
 	int np;
-	int nh;          /* horizontal rows per image row */
-	int nv;          /* vertical moments per pixel */
-	int hbase[64];   /* first horizontal row of each plane */
-	int hcount[64];  /* horizontal kernels of each plane: 1, 2, 3 or 6 */
+	int nh;                /* horizontal rows per image row */
+	int nv;                /* vertical moments per pixel */
+	int hbase[MAXPLANES];  /* first horizontal row of each plane */
+	int hcount[MAXPLANES]; /* horizontal kernels of each plane: 1, 2, 3 or 6 */
+	/* A plane's value at a pixel is v[fa] * v[fb] (or v[fa] when fb < 0),
+	 * where v is the pixel's colours followed by its features. */
+	int fa[MAXPLANES], fb[MAXPLANES];
 };
 
 static void layout_init(struct layout *l, int nch, int nf)
@@ -49,20 +55,28 @@ static void layout_init(struct layout *l, int nch, int nf)
 	l->nf = nf;
 	l->nff = nf * (nf + 1) / 2;
 	l->np = nch + nf + l->nff + nf * nch;
-	int h = 0, v = 0;
-	for (int p = 0; p < l->np; p++) {
-		int k;
-		if (p < nch)
-			k = 3, v += 6;               /* colours: W moments */
-		else if (p < nch + nf)
-			k = 6, v += 12;              /* features: W and W^2 moments */
-		else if (p < nch + nf + l->nff)
-			k = 2, v += 2;               /* feature products: W and W^2 */
-		else
-			k = 1, v += 1;               /* feature-colour products: W */
+	int h = 0, v = 0, p = 0;
+	for (int c = 0; c < nch; c++, p++) {          /* colours: W moments */
+		l->fa[p] = c, l->fb[p] = -1;
+		l->hcount[p] = 3, v += 6;
+	}
+	for (int a = 0; a < nf; a++, p++) {           /* features: W and W^2 moments */
+		l->fa[p] = nch + a, l->fb[p] = -1;
+		l->hcount[p] = 6, v += 12;
+	}
+	for (int a = 0; a < nf; a++)                  /* feature products: W and W^2 */
+		for (int b = a; b < nf; b++, p++) {
+			l->fa[p] = nch + a, l->fb[p] = nch + b;
+			l->hcount[p] = 2, v += 2;
+		}
+	for (int a = 0; a < nf; a++)                  /* feature-colour products: W */
+		for (int c = 0; c < nch; c++, p++) {
+			l->fa[p] = nch + a, l->fb[p] = c;
+			l->hcount[p] = 1, v += 1;
+		}
+	for (p = 0; p < l->np; p++) {
 		l->hbase[p] = h;
-		l->hcount[p] = k;
-		h += k;
+		h += l->hcount[p];
 	}
 	l->nh = h;
 	l->nv = v;
@@ -77,28 +91,6 @@ size_t lpr_feat_scratch(int w, int nch, int nf, int nrows, int r)
 	       + (size_t)l.nv * w                          /* vertical moments of a row */
 	       + wp                                        /* one padded plane row */
 	       + 10 * (size_t)w;                           /* 1-D kernel sums per x */
-}
-
-/* The value of plane p at pixel i. */
-static inline double plane_value(const struct layout *l, int p, const float *y,
-				 const float *f)
-{
-	if (p < l->nch)
-		return y[p];
-	p -= l->nch;
-	if (p < l->nf)
-		return f[p];
-	p -= l->nf;
-	if (p < l->nff) {
-		int a = 0;
-		while (p >= l->nf - a) {
-			p -= l->nf - a;
-			a++;
-		}
-		return (double)f[a] * f[a + p];
-	}
-	p -= l->nff;
-	return (double)f[p / l->nch] * y[p % l->nch];
 }
 
 /* Index of the product f_a f_b (a <= b) among the feature products. */
@@ -183,9 +175,19 @@ long lpr_feat_strip(const struct lpr_filters *f, const struct lpr_image *img,
 		for (int p = 0; p < l.np; p++) {
 			for (int i = 0; i < r; i++)
 				prow[i] = prow[w + r + i] = 0.0;
-			for (int x = 0; x < w; x++)
-				prow[x + r] = plane_value(&l, p, yrow + (size_t)x * nch,
-							  frow + (size_t)x * nf);
+			/* the one or two channels the plane is made of */
+			const int fa = l.fa[p], fb = l.fb[p];
+			const float *pa = fa < nch ? yrow + fa : frow + (fa - nch);
+			const size_t sa = fa < nch ? (size_t)nch : (size_t)nf;
+			if (fb < 0) {
+				for (int x = 0; x < w; x++)
+					prow[x + r] = pa[x * sa];
+			} else {
+				const float *pb = fb < nch ? yrow + fb : frow + (fb - nch);
+				const size_t sb = fb < nch ? (size_t)nch : (size_t)nf;
+				for (int x = 0; x < w; x++)
+					prow[x + r] = (double)pa[x * sa] * pb[x * sb];
+			}
 			for (int k = 0; k < l.hcount[p]; k++) {
 				/* planes with 2 rows use (t, q); otherwise t.. in order */
 				int kern = l.hcount[p] == 2 ? (k ? HQ : HT) : k;

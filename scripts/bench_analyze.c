@@ -38,8 +38,6 @@ static double gauss(void)
 	return sqrt(-2.0 * log(u[0])) * cos(6.283185307179586 * u[1]);
 }
 
-static double best_time(const struct lpr_image *img, const struct lpr_params *p, int reps);
-
 static void make_image(float *px, int w, int h)
 {
 	for (int y = 0; y < h; y++)

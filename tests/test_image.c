@@ -127,21 +127,6 @@ static void assert_err_names(const char *err, const char *path)
 		fail_msg("message \"%s\" does not name '%s'", err, path);
 }
 
-/* Count directory entries whose name contains part. */
-static int count_entries(const char *dir, const char *part)
-{
-	DIR *d = opendir(dir);
-	struct dirent *e;
-	int n = 0;
-
-	assert_non_null(d);
-	while ((e = readdir(d)))
-		if (strstr(e->d_name, part))
-			n++;
-	closedir(d);
-	return n;
-}
-
 static const char *const rgb_names[] = { "R", "G", "B" };
 static const char *const bgr_names[] = { "B", "G", "R" };
 

@@ -94,20 +94,6 @@ static int sh_c(const char *line)
 	return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
-/* Entries of dir whose name contains part. */
-static int count_entries(const char *dir, const char *part)
-{
-	DIR *d = opendir(dir);
-	struct dirent *e;
-	int n = 0;
-
-	assert_non_null(d);
-	while ((e = readdir(d)))
-		n += strstr(e->d_name, part) != NULL;
-	closedir(d);
-	return n;
-}
-
 static void pause_s(double s)
 {
 	struct timespec ts = { (time_t)s, (long)((s - (double)(time_t)s) * 1e9) };

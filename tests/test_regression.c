@@ -709,6 +709,38 @@ static void test_fast_vs_general(void **state)
 	free(m.px);
 }
 
+/* The most channels and features the library takes: the moment path has a
+ * plane per channel, feature and product of them (188 here). */
+static void test_max_channels_and_features(void **state)
+{
+	(void)state;
+	rng_seed(31);
+	struct img m = img_new(24, 20, LPR_MAXCH), f = img_new(24, 20, LPR_MAXFEAT);
+	for (size_t i = 0; i < (size_t)24 * 20 * LPR_MAXCH; i++)
+		m.px[i] = (float)(0.5 + 0.05 * gauss());
+	for (size_t i = 0; i < (size_t)24 * 20 * LPR_MAXFEAT; i++)
+		f.px[i] = (float)urand();
+	struct lpr_params p;
+	lpr_params_init(&p);
+	p.radii[0] = 2;
+	p.radii[1] = 3;
+	p.nradii = 2;
+	struct lpr_result a = analyze(&m, &f, &p);
+	p.force_general = 1;
+	struct lpr_result b = analyze(&m, &f, &p);
+	assert_true(a.fast_pixels > 0);
+	for (size_t i = 0; i < (size_t)24 * 20; i++) {
+		assert_true(isfinite(a.error[i]));
+		assert_true(fabs(a.error[i] - b.error[i]) <= 1e-4 * b.error[i] + 1e-12);
+		for (int c = 0; c < LPR_MAXCH; c++)
+			assert_true(fabs(a.fit[i * LPR_MAXCH + c] - b.fit[i * LPR_MAXCH + c]) < 1e-5);
+	}
+	lpr_result_release(&a);
+	lpr_result_release(&b);
+	free(m.px);
+	free(f.px);
+}
+
 /* Mirroring the image mirrors the analysis (and negates the slope). */
 static void test_mirror_symmetry(void **state)
 {
@@ -816,6 +848,7 @@ int main(void)
 		cmocka_unit_test(test_texture_features),
 		cmocka_unit_test(test_degenerate_features),
 		cmocka_unit_test(test_fast_vs_general),
+		cmocka_unit_test(test_max_channels_and_features),
 		cmocka_unit_test(test_mirror_symmetry),
 		cmocka_unit_test(test_threads_identical),
 		cmocka_unit_test(test_bad_arguments),

@@ -1,14 +1,16 @@
 /*
  * testutil.h - helpers shared by the cmocka tests: a scratch directory,
- * shell commands, and checks on images.  Include after <cmocka.h>; each
+ * shell commands, and checks on files and images.  Include after <cmocka.h>; each
  * test program gets its own copy (everything here is static).
  */
 #ifndef POVPRESS_TESTUTIL_H
 #define POVPRESS_TESTUTIL_H
 
+#include <dirent.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/wait.h>
 
 #include "driver/image.h"
@@ -46,6 +48,20 @@ TESTUTIL_UNUSED static int run(const char *fmt, ...)
 	if (st == -1 || !WIFEXITED(st))
 		return -1;
 	return WEXITSTATUS(st);
+}
+
+/* Entries of dir whose name contains part. */
+TESTUTIL_UNUSED static int count_entries(const char *dir, const char *part)
+{
+	DIR *d = opendir(dir);
+	struct dirent *e;
+	int n = 0;
+
+	assert_non_null(d);
+	while ((e = readdir(d)))
+		n += strstr(e->d_name, part) != NULL;
+	closedir(d);
+	return n;
 }
 
 /* A failed call leaves its output image zeroed. */
