@@ -14,4 +14,13 @@ int cmd_analyze(int argc, char **argv);
 /* povpress compare IMAGE.exr REF.exr: print relMSE, MSE and PSNR. */
 int cmd_compare(int argc, char **argv);
 
+/* povpress render SCENE.pov -o OUT.exr: the adaptive re-rendering loop. */
+int cmd_render(int argc, char **argv);
+
+/* povpress plan ANALYSIS.exr -o DIR: pixels, regions and POV-Ray jobs. */
+int cmd_plan(int argc, char **argv);
+
+/* povpress merge: fold region renders into an accumulation. */
+int cmd_merge(int argc, char **argv);
+
 #endif

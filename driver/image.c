@@ -242,6 +242,8 @@ struct reader {
 	const char *path;
 	char *err;
 	size_t errlen;
+	int band;		/* read only rows band_y0..band_y1 (scanline files) */
+	int band_y0, band_y1;	/* in: wanted rows; out: rows read, image-relative */
 };
 
 /*
@@ -324,15 +326,22 @@ static int read_scanlines(struct reader *rd, const exr_attr_box2i_t *dw)
 		set_exr_err(rd->err, rd->errlen, "read", rd->path, rv);
 		return -1;
 	}
+	int64_t ylo = dw->min.y, yhi = dw->max.y;
+	if (rd->band) {
+		/* whole chunks: from the chunk holding the first wanted row */
+		ylo = dw->min.y + (int64_t)rd->band_y0 / lpc * lpc;
+		yhi = dw->min.y + (int64_t)rd->band_y1;
+	}
 	/* int64_t: a data window ending at INT_MAX must not overflow y */
-	for (int64_t y = dw->min.y; y <= dw->max.y; y += lpc) {
+	for (int64_t y = ylo; y <= yhi; y += lpc) {
 		exr_msg_reset();
 		rv = exr_read_scanline_chunk_info(rd->ctx, 0, (int)y, &ci);
 		if (rv != EXR_ERR_SUCCESS) {
 			set_pixel_err(rd->err, rd->errlen, rd->path, rv);
 			return -1;
 		}
-		if (read_chunk(rd, &ci, ci.start_x - dw->min.x, ci.start_y - dw->min.y))
+		if (read_chunk(rd, &ci, ci.start_x - dw->min.x,
+			       ci.start_y - (int)(rd->band ? ylo : dw->min.y)))
 			return -1;
 	}
 	return 0;
@@ -455,6 +464,35 @@ static int read_part0(struct reader *rd)
 			}
 		}
 	}
+	if (rd->band && storage == EXR_STORAGE_SCANLINE) {
+		int32_t lpc = 0;
+
+		rv = exr_get_scanlines_per_chunk(rd->ctx, 0, &lpc);
+		if (rv == EXR_ERR_SUCCESS && lpc <= 0)
+			rv = EXR_ERR_INVALID_ATTR;
+		if (rv != EXR_ERR_SUCCESS) {
+			set_exr_err(rd->err, rd->errlen, "read", rd->path, rv);
+			goto out;
+		}
+		int64_t y0 = rd->band_y0 < 0 ? 0 : rd->band_y0;
+		int64_t y1 = rd->band_y1 >= h ? h - 1 : rd->band_y1;
+		if (y0 > y1) {
+			errbuf_printf(rd->err, rd->errlen, "cannot read rows %d..%d of '%s': it has "
+				"%lld rows", rd->band_y0, rd->band_y1, rd->path, (long long)h);
+			goto out;
+		}
+		y0 = y0 / lpc * lpc;
+		y1 = (y1 / lpc + 1) * lpc - 1;
+		if (y1 >= h)
+			y1 = h - 1;
+		rd->band_y0 = (int)y0;
+		rd->band_y1 = (int)y1;
+		h = y1 - y0 + 1;
+	} else {
+		rd->band = 0;
+		rd->band_y0 = 0;
+		rd->band_y1 = (int)h - 1;
+	}
 	if (image_init(rd->img, (int)w, (int)h, chl->num_channels, names, rd->err, rd->errlen)) {
 		char why[200];
 
@@ -471,7 +509,22 @@ out:
 	return ret;
 }
 
+static int read_exr(const char *path, int band, int y0, int y1, struct image *out,
+		    int *oy, char *err, size_t errlen);
+
 int image_read_exr(const char *path, struct image *out, char *err, size_t errlen)
+{
+	return read_exr(path, 0, 0, 0, out, NULL, err, errlen);
+}
+
+int image_read_exr_rows(const char *path, int y0, int y1, struct image *out, int *oy,
+			char *err, size_t errlen)
+{
+	return read_exr(path, 1, y0, y1, out, oy, err, errlen);
+}
+
+static int read_exr(const char *path, int band, int y0, int y1, struct image *out,
+		    int *oy, char *err, size_t errlen)
 {
 	exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
 	struct exr_src src = { -1, 0 };
@@ -488,6 +541,9 @@ int image_read_exr(const char *path, struct image *out, char *err, size_t errlen
 	rd.path = path;
 	rd.err = err;
 	rd.errlen = errlen;
+	rd.band = band;
+	rd.band_y0 = y0;
+	rd.band_y1 = y1;
 
 	src.fd = open(path, O_RDONLY | O_CLOEXEC);
 	if (src.fd < 0) {
@@ -529,6 +585,8 @@ int image_read_exr(const char *path, struct image *out, char *err, size_t errlen
 		goto out;
 	}
 	ret = read_part0(&rd);
+	if (!ret && oy)
+		*oy = rd.band_y0;
 out:
 	if (rd.started)
 		exr_decoding_destroy(rd.ctx, &rd.dec);

@@ -44,6 +44,15 @@ int image_channel(const struct image *img, const char *name);
 int image_read_exr(const char *path, struct image *out, char *err, size_t errlen);
 
 /*
+ * Read only rows y0..y1 (0-based, of the data window) of an EXR, for a
+ * region of a large image: whole scanline chunks are decoded, so the image
+ * may hold a few rows more; *oy receives the file row of its first row.
+ * Tiled files are read whole (*oy = 0).  Errors as image_read_exr().
+ */
+int image_read_exr_rows(const char *path, int y0, int y1, struct image *out, int *oy,
+			char *err, size_t errlen);
+
+/*
  * Write img as a single-part scanline EXR, 32-bit float, PIZ compression,
  * one channel per img channel with img's names (OpenEXR stores channels
  * sorted by name, so image_read_exr() returns them in that order).  Names

@@ -12,6 +12,11 @@ static const char usage[] =
 	"Adaptive sampling for POV-Ray by local polynomial regression and PRESS.\n"
 	"\n"
 	"commands:\n"
+	"  render SCENE.pov -o OUT.exr render adaptively through POV-Ray: base pass, then\n"
+	"                              region re-renders where the error estimate is high\n"
+	"  plan ANALYSIS.exr -o DIR    the pixels that need samples, packed regions and a\n"
+	"                              POV-Ray job list (one command line per region)\n"
+	"  merge ACCUM.exr REGIONS     fold finished region renders into an accumulation\n"
 	"  analyze IN.exr -o OUT.exr   reconstruction, error estimate, order, bandwidth,\n"
 	"                              gradients of an image\n"
 	"  compare IMAGE.exr REF.exr   relMSE, MSE and PSNR of an image against a reference\n"
@@ -31,6 +36,12 @@ int main(int argc, char **argv)
 	}
 	if (!strcmp(cmd, "analyze"))
 		return cmd_analyze(argc - 1, argv + 1);
+	if (!strcmp(cmd, "render"))
+		return cmd_render(argc - 1, argv + 1);
+	if (!strcmp(cmd, "plan"))
+		return cmd_plan(argc - 1, argv + 1);
+	if (!strcmp(cmd, "merge"))
+		return cmd_merge(argc - 1, argv + 1);
 	if (!strcmp(cmd, "compare"))
 		return cmd_compare(argc - 1, argv + 1);
 	fprintf(stderr, "povpress: unknown command '%s'\n\n%s", cmd, usage);

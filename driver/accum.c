@@ -1,0 +1,291 @@
+/*
+ * accum.c - the accumulated render (see accum.h).
+ *
+ * Sample sets are combined with the pairwise update of Chan, Golub and
+ * LeVeque: means and sums of squared deviations, never sums of squares,
+ * so a bright, nearly constant pixel keeps its variance digits.
+ */
+#include "driver/accum.h"
+#include "driver/errbuf.h"
+#include "driver/metrics.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+const int accum_scales[ACC_NSCALES] = { 1, 2, 4, 8, 16 };
+
+const char *const accum_names[ACC_NCH] = {
+	"R", "G", "B", "samples", "var.R", "var.G", "var.B", "pass", "scales",
+};
+
+static uint32_t scale_mask(const struct image *acc, size_t i)
+{
+	float m = acc->px[i * ACC_NCH + ACC_SCALES];
+	return m >= 0.0f && m < 4294967296.0f ? (uint32_t)m : 0;
+}
+
+int accum_has_scale(const struct image *acc, size_t i, int s)
+{
+	return s >= 0 && s < 32 && (scale_mask(acc, i) >> s & 1u);
+}
+
+int accum_next_scale(const struct image *acc, size_t i)
+{
+	for (int k = 0; k < ACC_NSCALES; k++)
+		if (!accum_has_scale(acc, i, accum_scales[k]))
+			return accum_scales[k];
+	return 0;
+}
+
+int accum_from_base(const struct image *base, const char *what, struct image *acc, char *err,
+		    size_t errlen)
+{
+	struct image rgb = {0};
+	if (image_rgb(base, what, &rgb, err, errlen))
+		return -1;
+	if (image_init(acc, rgb.w, rgb.h, ACC_NCH, accum_names, err, errlen)) {
+		image_release(&rgb);
+		return -1;
+	}
+	size_t n = (size_t)rgb.w * rgb.h;
+	for (size_t i = 0; i < n; i++) {
+		float *o = acc->px + i * ACC_NCH;
+		int ok = 1;
+		for (int c = 0; c < 3; c++) {
+			o[c] = rgb.px[i * 3 + c];
+			ok &= isfinite(o[c]) != 0;
+		}
+		/* a pixel POV-Ray could not shade counts as no sample */
+		o[ACC_SAMPLES] = ok ? 1.0f : 0.0f;
+		o[ACC_SCALES] = 2.0f;	/* bit 1: scale 1 */
+	}
+	image_release(&rgb);
+	return 0;
+}
+
+int accum_read(const char *path, struct image *acc, char *err, size_t errlen)
+{
+	struct image raw = {0};
+	if (image_read_exr(path, &raw, err, errlen))
+		return -1;
+	int idx[ACC_NCH];
+	for (int c = 0; c < ACC_NCH; c++) {
+		idx[c] = image_channel(&raw, accum_names[c]);
+		if (idx[c] < 0) {
+			errbuf_printf(err, errlen, "'%s' is not an accumulation: it has no '%s' "
+				      "channel (write one with 'povpress merge --init')", path,
+				      accum_names[c]);
+			image_release(&raw);
+			return -1;
+		}
+	}
+	if (image_init(acc, raw.w, raw.h, ACC_NCH, accum_names, err, errlen)) {
+		image_release(&raw);
+		return -1;
+	}
+	size_t n = (size_t)raw.w * raw.h;
+	for (size_t i = 0; i < n; i++)
+		for (int c = 0; c < ACC_NCH; c++)
+			acc->px[i * ACC_NCH + c] = raw.px[i * raw.nch + idx[c]];
+	image_release(&raw);
+	return 0;
+}
+
+int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
+	       const double m2[3], int pass)
+{
+	float *o = acc->px + i * ACC_NCH;
+	if (accum_has_scale(acc, i, s))
+		return 1;
+	o[ACC_SCALES] = (float)(scale_mask(acc, i) | 1u << s);
+	if (n <= 0)
+		return 0;
+	double na = o[ACC_SAMPLES], nb = n, nt = na + nb;
+	for (int c = 0; c < 3; c++) {
+		double ma = na > 0 ? o[c] : 0.0;
+		double m2a = na > 1 ? (double)o[ACC_VAR_R + c] * (na - 1.0) : 0.0;
+		double d = mean[c] - ma;
+		double mt = ma + d * nb / nt;
+		double m2t = m2a + m2[c] + d * d * na * nb / nt;
+		o[c] = (float)mt;
+		o[ACC_VAR_R + c] = nt > 1 ? (float)(m2t / (nt - 1.0)) : 0.0f;
+	}
+	o[ACC_SAMPLES] = (float)nt;
+	o[ACC_PASS] = (float)pass;
+	return 0;
+}
+
+int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
+		       int y0, int x1, int y1, int pass, long *folded, char *err,
+		       size_t errlen)
+{
+	if (folded)
+		*folded = 0;
+	if (s < 1 || s > 16 || (s & (s - 1)) != 0) {
+		errbuf_printf(err, errlen, "scale %d is not one of 1, 2, 4, 8, 16", s);
+		return -1;
+	}
+	if (x0 < 0 || y0 < 0 || x1 >= acc->w || y1 >= acc->h || x0 > x1 || y0 > y1) {
+		errbuf_printf(err, errlen, "region %d,%d-%d,%d lies outside the %dx%d image", x0,
+			      y0, x1, y1, acc->w, acc->h);
+		return -1;
+	}
+	if (img->w != acc->w * s) {
+		errbuf_printf(err, errlen, "the render is %d pixels wide, not %d (%d x %d)", img->w,
+			      acc->w * s, acc->w, s);
+		return -1;
+	}
+	if (oy > y0 * s || oy + img->h < (y1 + 1) * s) {
+		errbuf_printf(err, errlen, "the render lacks rows %d..%d", y0 * s,
+			      (y1 + 1) * s - 1);
+		return -1;
+	}
+	int ir = image_channel(img, "R"), ig = image_channel(img, "G"),
+	    ib = image_channel(img, "B");
+	if (ir < 0 || ig < 0 || ib < 0) {
+		errbuf_printf(err, errlen, "the render has no R, G and B channels");
+		return -1;
+	}
+	const int ch[3] = { ir, ig, ib };
+	long count = 0;
+	for (int y = y0; y <= y1; y++) {
+		for (int x = x0; x <= x1; x++) {
+			double sum[3] = {0}, mean[3], m2[3] = {0};
+			int n = 0;
+			for (int pass2 = 0; pass2 < 2; pass2++) {
+				for (int j = 0; j < s; j++) {
+					const float *row = img->px +
+						((size_t)(y * s + j - oy) * img->w + (size_t)x * s) *
+						img->nch;
+					for (int k = 0; k < s; k++) {
+						const float *p = row + (size_t)k * img->nch;
+						if (!isfinite(p[ch[0]]) || !isfinite(p[ch[1]]) ||
+						    !isfinite(p[ch[2]]))
+							continue;
+						for (int c = 0; c < 3; c++) {
+							if (!pass2) {
+								sum[c] += p[ch[c]];
+							} else {
+								double d = p[ch[c]] - mean[c];
+								m2[c] += d * d;
+							}
+						}
+						n += !pass2;
+					}
+				}
+				if (!pass2)
+					for (int c = 0; c < 3; c++)
+						mean[c] = n ? sum[c] / n : 0.0;
+			}
+			size_t i = (size_t)y * acc->w + x;
+			if (!accum_fold(acc, i, s, n, mean, m2, pass) && n)
+				count++;
+		}
+	}
+	if (folded)
+		*folded = count;
+	return 0;
+}
+
+/* The finest scale pixel i has been sampled at. */
+static int finest_scale(const struct image *acc, size_t i)
+{
+	int best = 1;
+	for (int k = 0; k < ACC_NSCALES; k++)
+		if (accum_has_scale(acc, i, accum_scales[k]))
+			best = accum_scales[k];
+	return best;
+}
+
+double accum_contrast(const struct image *acc, size_t i, const float fit[3])
+{
+	const int w = acc->w, h = acc->h, x = (int)(i % (size_t)w), y = (int)(i / (size_t)w);
+	const float *o = acc->px + i * ACC_NCH;
+	double best = 0.0;
+	for (int dy = -1; dy <= 1; dy++)
+		for (int dx = -1; dx <= 1; dx++) {
+			if ((!dx && !dy) || x + dx < 0 || x + dx >= w || y + dy < 0 || y + dy >= h)
+				continue;
+			const float *q = acc->px + ((size_t)(y + dy) * w + (x + dx)) * ACC_NCH;
+			if (!(q[ACC_SAMPLES] > 0.0f))
+				continue;
+			double d2 = 0.0;
+			for (int c = 0; c < 3; c++) {
+				double f = isfinite(fit[c]) ? fit[c] : o[c];
+				double d = (double)q[c] - o[c];
+				d2 += d * d / (f * f + METRICS_RELMSE_EPS) / 3.0;
+			}
+			if (d2 > best)
+				best = d2;
+		}
+	return isfinite(best) ? best : 1.0;
+}
+
+double accum_pixel_error(const struct image *acc, size_t i, double press, const float fit[3],
+			 double contrast)
+{
+	const float *o = acc->px + i * ACC_NCH;
+	double den = 0.0, vrel = 0.0;
+	for (int c = 0; c < 3; c++) {
+		double f = isfinite(fit[c]) ? fit[c] : o[c];
+		double d = f * f + METRICS_RELMSE_EPS;
+		den += d / 3.0;
+		vrel += o[ACC_VAR_R + c] / d / 3.0;
+	}
+	/* no estimate (a hole the regression could not reach): assume the worst
+	 * a pixel of this brightness can plausibly be off by */
+	double e = isfinite(press) ? press / den : 1.0;
+	double n = o[ACC_SAMPLES];
+	if (n >= 4.0) {
+		double ev = vrel / n;
+		if (ev < e)
+			e = ev;
+	}
+	/* an edge or a detail between every sample position so far: a grid of
+	 * s x s samples places an edge with an error of up to 1/(2s) of the
+	 * pixel, uniform, so its squared error is contrast^2 / (12 s^2) */
+	int s = finest_scale(acc, i);
+	double edge = contrast / (12.0 * s * s);
+	if (edge > e)
+		e = edge;
+	if (n <= 0.0)
+		e = 1.0;
+	return e;
+}
+
+long accum_final_image(const struct image *acc, const float *fit, const float *press,
+		       const float *leverage, enum accum_final mode, float *rgb)
+{
+	size_t npx = (size_t)acc->w * acc->h;
+	long took = 0;
+	for (size_t i = 0; i < npx; i++) {
+		const float *o = acc->px + i * ACC_NCH;
+		const float *f = fit + 3 * i;
+		double n = o[ACC_SAMPLES];
+		int fin = isfinite(f[0]) && isfinite(f[1]) && isfinite(f[2]);
+		int use_fit;
+		if (n <= 0.0)
+			use_fit = 1;
+		else if (!fin || mode == ACC_FINAL_SAMPLES)
+			use_fit = 0;
+		else if (mode == ACC_FINAL_RECONSTRUCTION)
+			use_fit = 1;
+		else {
+			double h = leverage[i], e = press[i];
+			if (!isfinite(h) || !isfinite(e) || h < 0.0 || h > 1.0) {
+				use_fit = 0;
+			} else {
+				double v = e / (1.0 + h);
+				if (n >= 4.0)
+					v = (o[ACC_VAR_R] + o[ACC_VAR_G] + o[ACC_VAR_B]) / 3.0 / n;
+				double bias = e - v > 0.0 ? e - v : 0.0;
+				use_fit = h * h * v + (1.0 - h) * (1.0 - h) * bias < v;
+			}
+		}
+		for (int c = 0; c < 3; c++)
+			rgb[3 * i + c] = use_fit ? f[c] : o[c];
+		took += use_fit;
+	}
+	return took;
+}

@@ -1,0 +1,121 @@
+/*
+ * accum.h - the accumulated render: every sample POV-Ray has produced for a
+ * pixel, folded into a running mean, count and variance.
+ *
+ * An accumulation is an image with these channels (the order of this list
+ * in memory; in a file they are matched by name):
+ *
+ *   R G B          mean of every sample of the pixel so far
+ *   samples        how many samples that mean is over
+ *   var.R var.G var.B
+ *                  unbiased variance of those samples (0 while samples < 2)
+ *   pass           the pass that last added samples (0: the base pass)
+ *   scales         the resolution scales already sampled, as a bit mask
+ *                  (bit s for scale s; the base pass is scale 1)
+ *
+ * Samples are added by resolution scaling: a region rendered at s times the
+ * resolution gives every pixel s x s new samples on a regular grid of sub-
+ * pixel positions.  The grids of scales 1, 2, 4, 8 and 16 share no
+ * position, so their samples are new information even for a scene without
+ * any randomness; a scale already in a pixel's mask would repeat positions
+ * it has, and is skipped.
+ */
+#ifndef POVPRESS_ACCUM_H
+#define POVPRESS_ACCUM_H
+
+#include <stddef.h>
+
+#include "driver/image.h"
+
+enum {
+	ACC_R, ACC_G, ACC_B, ACC_SAMPLES, ACC_VAR_R, ACC_VAR_G, ACC_VAR_B, ACC_PASS, ACC_SCALES,
+	ACC_NCH
+};
+
+/* The scales a pixel can be sampled at, in the order they are used. */
+#define ACC_NSCALES 5
+extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
+
+/* The channel names, in ACC_* order. */
+extern const char *const accum_names[ACC_NCH];
+
+/* A new accumulation from a base render (its R, G, B; one sample per
+ * pixel at scale 1, pass 0). */
+int accum_from_base(const struct image *base, const char *what, struct image *acc, char *err,
+		    size_t errlen);
+
+/* Read an accumulation, checking that every channel is there. */
+int accum_read(const char *path, struct image *acc, char *err, size_t errlen);
+
+/* The smallest scale pixel i has not been sampled at, or 0 if none is
+ * left. */
+int accum_next_scale(const struct image *acc, size_t i);
+
+/* Whether pixel i has samples at scale s. */
+int accum_has_scale(const struct image *acc, size_t i, int s);
+
+/*
+ * Fold s x s samples of pixel i (n of them finite, their mean and sum of
+ * squared deviations per channel) into the accumulation, and mark scale s
+ * and the pass.  Returns 0 when folded, 1 when the pixel already had scale
+ * s (nothing changes).
+ */
+int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
+	       const double m2[3], int pass);
+
+/*
+ * Fold a region render at scale s into acc: img holds rows oy.. of the
+ * s*W x s*H render (as image_read_exr_rows() returns them), and the
+ * pixels of rectangle x0..x1, y0..y1 (inclusive, in acc's pixels) take the
+ * mean of their s x s blocks.  *folded counts the pixels that took new
+ * samples (may be NULL).  Fails on a size mismatch or rows not read.
+ */
+int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
+		       int y0, int x1, int y1, int pass, long *folded, char *err,
+		       size_t errlen);
+
+/*
+ * The largest relative squared difference between pixel i's mean and one
+ * of its eight neighbours' (mean over R, G, B of difference^2 over
+ * fit^2 + 0.01): how much an edge through the pixel could be worth.
+ */
+double accum_contrast(const struct image *acc, size_t i, const float fit[3]);
+
+/*
+ * The estimated relative squared error of pixel i's mean (a term of
+ * relMSE: squared error over value^2 + 0.01; 1 when unknown), the largest
+ * of two estimates:
+ * - noise: the regression's error estimate press (mean over R, G, B of the
+ *   squared error, NaN if none; fit is its R, G, B) and, once the pixel
+ *   has 4 or more samples, its sample variance over its sample count: the
+ *   smaller of the two, as both overestimate (PRESS counts detail the
+ *   regression cannot model, the variance of stratified samples exceeds
+ *   that of their mean);
+ * - edges: an edge between all the sample positions is invisible to both,
+ *   so with contrast from accum_contrast() and s the pixel's finest scale,
+ *   contrast / (12 s^2), the expected squared error of placing an edge on
+ *   an s x s grid.
+ */
+double accum_pixel_error(const struct image *acc, size_t i, double press, const float fit[3],
+			 double contrast);
+
+/* What the final image holds per pixel. */
+enum accum_final {
+	ACC_FINAL_AUTO,			/* the one predicted to be closer (below) */
+	ACC_FINAL_SAMPLES,		/* the mean of the pixel's samples */
+	ACC_FINAL_RECONSTRUCTION,	/* the regression's fit */
+};
+
+/*
+ * Fill rgb (w*h*3) with the final image; returns how many pixels took the
+ * fit.  For ACC_FINAL_AUTO, per pixel: with v the variance of the samples'
+ * mean (the sample variance over n once n >= 4, else the PRESS error over
+ * 1 + H, what it is for pure noise) and H the pixel's leverage, the fit
+ * H Y + (1 - H) f(-i) is expected to miss by H^2 v + (1 - H)^2 (press - v),
+ * the samples by v; the smaller wins.  Pixels without a finite fit keep
+ * their samples, pixels without samples take the fit.
+ */
+long accum_final_image(const struct image *acc, const float *fit, const float *press,
+		       const float *leverage, enum accum_final mode, float *rgb);
+
+#endif

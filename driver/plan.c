@@ -1,0 +1,530 @@
+/*
+ * plan.c - choose pixels, pack rectangles, write regions (see plan.h).
+ */
+#include "driver/plan.h"
+#include "driver/accum.h"
+#include "driver/errbuf.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void plan_params_init(struct plan_params *p)
+{
+	memset(p, 0, sizeof(*p));
+	p->target = 1e-3;
+	p->margin = 0.7;
+	p->cost_job = 0.05;
+	p->cost_sample = 2e-6;
+	p->max_regions = 64;
+	p->tile = 8;
+	p->min_gain = 0.05;
+}
+
+const char *plan_outcome_name(enum plan_outcome o)
+{
+	switch (o) {
+	case PLAN_REFINE: return "refine";
+	case PLAN_TARGET_MET: return "target met";
+	case PLAN_NO_GAIN: return "no pixel would gain";
+	case PLAN_NO_BUDGET: return "budget spent";
+	}
+	return "?";
+}
+
+double plan_pixel_errors(const struct image *acc, const float *press, const float *fit,
+			 double *e)
+{
+	size_t n = (size_t)acc->w * acc->h;
+	double sum = 0.0;
+	for (size_t i = 0; i < n; i++) {
+		e[i] = accum_pixel_error(acc, i, press[i], fit + 3 * i,
+					 accum_contrast(acc, i, fit + 3 * i));
+		sum += e[i];
+	}
+	return n ? sum / n : 0.0;
+}
+
+struct cand {
+	size_t i;
+	double gain, score;
+};
+
+static int by_score(const void *a, const void *b)
+{
+	const struct cand *x = a, *y = b;
+	if (x->score != y->score)
+		return x->score < y->score ? 1 : -1;
+	return x->i < y->i ? -1 : x->i > y->i;	/* stable: the same plan every run */
+}
+
+static double rect_cost(const struct plan_params *p, const struct plan_region *r)
+{
+	double area = (double)(r->x1 - r->x0 + 1) * (r->y1 - r->y0 + 1);
+	return p->cost_job + p->cost_sample * area * r->scale * r->scale;
+}
+
+static void bbox(const struct plan_region *a, const struct plan_region *b,
+		 struct plan_region *o)
+{
+	*o = *a;
+	o->x0 = a->x0 < b->x0 ? a->x0 : b->x0;
+	o->y0 = a->y0 < b->y0 ? a->y0 : b->y0;
+	o->x1 = a->x1 > b->x1 ? a->x1 : b->x1;
+	o->y1 = a->y1 > b->y1 ? a->y1 : b->y1;
+	o->chosen = a->chosen + b->chosen;
+	o->gain = a->gain + b->gain;
+}
+
+static int inside(const struct plan_region *in, const struct plan_region *out)
+{
+	return in->x0 >= out->x0 && in->x1 <= out->x1 && in->y0 >= out->y0 && in->y1 <= out->y1;
+}
+
+/* The greedy merge is quadratic per step: more runs than this and the
+ * grid is made coarser. */
+#define PACK_MAX_RUNS 400
+
+/*
+ * Pack the chosen pixels of one scale (mark[i] set, gain[i] their gains)
+ * into rectangles appended to *rs.  tile is the grid.  Returns 0, -1 when
+ * out of memory, 1 when the grid leaves more than PACK_MAX_RUNS runs.
+ */
+static int pack(const struct plan_params *p, int w, int h, int s, const unsigned char *mark,
+		const double *gain, int tile, int cap, struct plan_region **rs, size_t *nrs)
+{
+	int tw = (w + tile - 1) / tile, th = (h + tile - 1) / tile;
+	struct plan_region *r = NULL;
+	size_t n = 0, alloc = 0;
+	int ret = -1;
+	/* runs of occupied tiles per tile row, extended downward when the row
+	 * below has a run with the same span */
+	int *open_of = malloc(sizeof(int) * (size_t)tw);	/* region index by run start */
+	if (!open_of)
+		return -1;
+	for (int tx = 0; tx < tw; tx++)
+		open_of[tx] = -1;
+	for (int ty = 0; ty < th; ty++) {
+		int tx = 0;
+		while (tx < tw) {
+			int occ = 0;
+			for (int y = ty * tile; y < (ty + 1) * tile && y < h && !occ; y++)
+				for (int x = tx * tile; x < (tx + 1) * tile && x < w; x++)
+					if (mark[(size_t)y * w + x]) {
+						occ = 1;
+						break;
+					}
+			if (!occ) {
+				open_of[tx] = -1;
+				tx++;
+				continue;
+			}
+			int t0 = tx;
+			for (tx++; tx < tw; tx++) {
+				int o2 = 0;
+				for (int y = ty * tile; y < (ty + 1) * tile && y < h && !o2; y++)
+					for (int x = tx * tile; x < (tx + 1) * tile && x < w; x++)
+						if (mark[(size_t)y * w + x]) {
+							o2 = 1;
+							break;
+						}
+				if (!o2)
+					break;
+			}
+			int x0 = t0 * tile, x1 = tx * tile - 1;
+			if (x1 >= w)
+				x1 = w - 1;
+			int k = open_of[t0];
+			if (k >= 0 && r[k].x0 == x0 && r[k].x1 == x1 && r[k].y1 == ty * tile - 1) {
+				r[k].y1 = (ty + 1) * tile - 1 < h ? (ty + 1) * tile - 1 : h - 1;
+			} else {
+				if (n == alloc) {
+					alloc = alloc ? 2 * alloc : 64;
+					void *q = realloc(r, alloc * sizeof(*r));
+					if (!q)
+						goto out;
+					r = q;
+				}
+				memset(&r[n], 0, sizeof(r[n]));
+				r[n].x0 = x0;
+				r[n].x1 = x1;
+				r[n].y0 = ty * tile;
+				r[n].y1 = (ty + 1) * tile - 1 < h ? (ty + 1) * tile - 1 : h - 1;
+				r[n].scale = s;
+				k = (int)n++;
+			}
+			for (int t = t0; t < tx; t++)
+				open_of[t] = -1;
+			open_of[t0] = k;
+			/* tiles t0+1.. of the run are closed for the next row: a run
+			 * continues only with the same span */
+		}
+	}
+	if (n > PACK_MAX_RUNS) {	/* too many to merge pairwise: a coarser grid */
+		ret = 1;
+		goto out;
+	}
+	/* shrink each rectangle to its chosen pixels; count them */
+	for (size_t k = 0; k < n; k++) {
+		int bx0 = r[k].x1, by0 = r[k].y1, bx1 = r[k].x0, by1 = r[k].y0;
+		for (int y = r[k].y0; y <= r[k].y1; y++)
+			for (int x = r[k].x0; x <= r[k].x1; x++) {
+				size_t i = (size_t)y * w + x;
+				if (!mark[i])
+					continue;
+				bx0 = x < bx0 ? x : bx0;
+				bx1 = x > bx1 ? x : bx1;
+				by0 = y < by0 ? y : by0;
+				by1 = y > by1 ? y : by1;
+				r[k].chosen++;
+				r[k].gain += gain[i];
+			}
+		r[k].x0 = bx0;
+		r[k].x1 = bx1;
+		r[k].y0 = by0;
+		r[k].y1 = by1;
+	}
+	/* greedy merging: the pair whose bounding box saves the most (or, over
+	 * the cap, costs the least extra) */
+	for (;;) {
+		double best = INFINITY;
+		size_t ba = 0, bb = 0;
+		for (size_t a = 0; a < n; a++)
+			for (size_t b = a + 1; b < n; b++) {
+				struct plan_region m;
+				bbox(&r[a], &r[b], &m);
+				double d = rect_cost(p, &m) - rect_cost(p, &r[a]) - rect_cost(p, &r[b]);
+				if (d < best) {
+					best = d;
+					ba = a;
+					bb = b;
+				}
+			}
+		if (n < 2 || (best > 0.0 && n <= (size_t)cap))
+			break;
+		struct plan_region m;
+		bbox(&r[ba], &r[bb], &m);
+		r[ba] = m;
+		r[bb] = r[--n];
+		/* absorb whatever now lies inside the merged box */
+		for (size_t k = 0; k < n; k++) {
+			if (k == ba || !inside(&r[k], &r[ba]))
+				continue;
+			r[ba].chosen += r[k].chosen;
+			r[ba].gain += r[k].gain;
+			r[k] = r[--n];
+			if (ba == n)
+				ba = k;
+			k--;
+		}
+	}
+	for (size_t k = 0; k < n; k++)
+		r[k].cost = rect_cost(p, &r[k]);
+	if (n) {
+		void *q = realloc(*rs, (*nrs + n) * sizeof(**rs));
+		if (!q)
+			goto out;
+		*rs = q;
+		memcpy(*rs + *nrs, r, n * sizeof(*r));
+		*nrs += n;
+	}
+	ret = 0;
+out:
+	free(open_of);
+	free(r);
+	return ret;
+}
+
+static int by_value(const void *a, const void *b)
+{
+	const struct plan_region *x = a, *y = b;
+	double vx = x->gain / x->cost, vy = y->gain / y->cost;
+	if (vx != vy)
+		return vx < vy ? 1 : -1;
+	if (x->y0 != y->y0)
+		return x->y0 - y->y0;
+	return x->x0 - y->x0;
+}
+
+static int by_position(const void *a, const void *b)
+{
+	const struct plan_region *x = a, *y = b;
+	if (x->scale != y->scale)
+		return x->scale - y->scale;
+	if (x->y0 != y->y0)
+		return x->y0 - y->y0;
+	return x->x0 - y->x0;
+}
+
+int plan_make(const struct image *acc, const float *press, const float *fit,
+	      const struct plan_params *p, struct plan *out, char *err, size_t errlen)
+{
+	const int w = acc->w, h = acc->h;
+	const size_t npx = (size_t)w * h;
+	double *e = NULL, *gain = NULL;
+	struct cand *cand = NULL;
+	unsigned char *mark = NULL;
+	int ret = -1;
+
+	memset(out, 0, sizeof(*out));
+	out->w = w;
+	out->h = h;
+	if (!(p->target > 0.0) || p->cost_job < 0.0 || !(p->cost_sample > 0.0) ||
+	    p->max_regions < 1 || p->tile < 1) {
+		errbuf_printf(err, errlen, "bad planning parameters");
+		return -1;
+	}
+	e = malloc(npx * sizeof(*e));
+	gain = calloc(npx, sizeof(*gain));
+	cand = malloc(npx * sizeof(*cand));
+	mark = malloc(npx);
+	out->scale = calloc(npx, sizeof(float));
+	out->chosen = calloc(npx, sizeof(float));
+	if (!e || !gain || !cand || !mark || !out->scale || !out->chosen) {
+		errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
+		goto out;
+	}
+	out->est_relmse = plan_pixel_errors(acc, press, fit, e);
+	out->est_after = out->est_relmse;
+	if (out->est_relmse <= p->target) {
+		out->outcome = PLAN_TARGET_MET;
+		ret = 0;
+		goto out;
+	}
+
+	size_t nc = 0;
+	for (size_t i = 0; i < npx; i++) {
+		int s = accum_next_scale(acc, i);
+		if (!s)
+			continue;
+		double n = acc->px[i * ACC_NCH + ACC_SAMPLES], m = (double)s * s;
+		double g = e[i] * m / (n + m);
+		if (g < p->min_gain * p->target)
+			continue;
+		cand[nc].i = i;
+		cand[nc].gain = g;
+		cand[nc].score = g / m;
+		nc++;
+	}
+	qsort(cand, nc, sizeof(*cand), by_score);
+
+	/* take pixels until the predicted error meets target * margin or the
+	 * samples alone would exceed the budget */
+	double total = out->est_relmse * (double)npx, goal = p->target * p->margin * (double)npx;
+	double spend = 0.0;
+	size_t taken = 0;
+	for (; taken < nc && total > goal; taken++) {
+		size_t i = cand[taken].i;
+		int s = accum_next_scale(acc, i);
+		double c = p->cost_sample * s * s;
+		if (p->budget > 0.0 && spend + c > p->budget)
+			break;
+		spend += c;
+		total -= cand[taken].gain;
+		gain[i] = cand[taken].gain;
+	}
+	if (!taken) {
+		out->outcome = nc ? PLAN_NO_BUDGET : PLAN_NO_GAIN;
+		ret = 0;
+		goto out;
+	}
+
+	/* pack per scale */
+	for (int k = 0; k < ACC_NSCALES; k++) {
+		int s = accum_scales[k], any = 0;
+		memset(mark, 0, npx);
+		for (size_t t = 0; t < taken; t++) {
+			size_t i = cand[t].i;
+			if (accum_next_scale(acc, i) == s) {
+				mark[i] = 1;
+				any = 1;
+			}
+		}
+		if (!any)
+			continue;
+		int rc, tile = p->tile;
+		while ((rc = pack(p, w, h, s, mark, gain, tile, p->max_regions, &out->regions,
+				  &out->nregions)) == 1)
+			tile *= 2;
+		if (rc) {
+			errbuf_printf(err, errlen, "out of memory packing regions");
+			goto out;
+		}
+	}
+
+	/* over the cap or the budget: drop the regions worth least per cost */
+	qsort(out->regions, out->nregions, sizeof(*out->regions), by_value);
+	while (out->nregions > (size_t)p->max_regions)
+		out->nregions--;
+	if (p->budget > 0.0) {
+		double c = 0.0;
+		size_t k = 0;
+		for (; k < out->nregions; k++) {
+			if (c + out->regions[k].cost > p->budget)
+				break;
+			c += out->regions[k].cost;
+		}
+		out->nregions = k;
+	}
+	if (!out->nregions) {
+		out->outcome = PLAN_NO_BUDGET;
+		ret = 0;
+		goto out;
+	}
+	qsort(out->regions, out->nregions, sizeof(*out->regions), by_position);
+
+	/* what the kept regions do */
+	double gained = 0.0;
+	for (size_t k = 0; k < out->nregions; k++) {
+		const struct plan_region *r = &out->regions[k];
+		for (int y = r->y0; y <= r->y1; y++)
+			for (int x = r->x0; x <= r->x1; x++) {
+				size_t i = (size_t)y * w + x;
+				if (accum_has_scale(acc, i, r->scale) || out->scale[i] == r->scale)
+					continue;
+				double n = acc->px[i * ACC_NCH + ACC_SAMPLES];
+				double m = (double)r->scale * r->scale;
+				if (out->scale[i] == 0.0f) {
+					out->pixels++;
+					gained += e[i] * m / (n + m);
+				}
+				out->scale[i] = (float)r->scale;
+				out->samples += m;
+				if (gain[i] > 0.0)
+					out->chosen[i] = 1.0f;
+			}
+		out->cost += r->cost;
+	}
+	for (size_t i = 0; i < npx; i++)
+		out->chosen_pixels += out->chosen[i] > 0.0f;
+	out->est_after = (out->est_relmse * (double)npx - gained) / (double)npx;
+	if (out->est_after < 0.0)
+		out->est_after = 0.0;
+	out->outcome = PLAN_REFINE;
+	ret = 0;
+out:
+	free(e);
+	free(gain);
+	free(cand);
+	free(mark);
+	if (ret)
+		plan_release(out);
+	return ret;
+}
+
+void plan_release(struct plan *pl)
+{
+	free(pl->scale);
+	free(pl->chosen);
+	free(pl->regions);
+	memset(pl, 0, sizeof(*pl));
+}
+
+void plan_job(const struct pov_job *base, const struct plan_region *r, const char *output,
+	      struct pov_region *region, const char **extra, struct pov_job *job)
+{
+	int s = r->scale;
+	*job = *base;
+	job->output = output;
+	job->width = base->width * s;
+	job->height = base->height * s;
+	region->x0 = r->x0 * s;
+	region->y0 = r->y0 * s;
+	region->x1 = (r->x1 + 1) * s - 1;
+	region->y1 = (r->y1 + 1) * s - 1;
+	job->region = region;
+	for (size_t k = 0; k < base->nextra; k++)
+		extra[k] = base->extra[k];
+	extra[base->nextra] = "-A";	/* our samples are the s x s grid */
+	job->extra = extra;
+	job->nextra = base->nextra + 1;
+}
+
+int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *outputs)
+{
+	fprintf(f, "# povpress regions: pass x0 y0 x1 y1 scale output (pixels 0-based, "
+		"inclusive)\n");
+	for (size_t k = 0; k < pl->nregions; k++) {
+		const struct plan_region *r = &pl->regions[k];
+		fprintf(f, "%d\t%d\t%d\t%d\t%d\t%d\t%s\n", pass, r->x0, r->y0, r->x1, r->y1,
+			r->scale, outputs[k]);
+	}
+	return ferror(f) ? -1 : 0;
+}
+
+int plan_regions_read(const char *path, struct plan_region **regions, char ***outputs,
+		      int **passes, size_t *n, char *err, size_t errlen)
+{
+	FILE *f = fopen(path, "r");
+	char line[8192];
+	size_t cnt = 0, alloc = 0;
+	int lineno = 0;
+
+	*regions = NULL;
+	*outputs = NULL;
+	*passes = NULL;
+	*n = 0;
+	if (!f) {
+		errbuf_printf(err, errlen, "cannot open '%s': %s", path, strerror(errno));
+		return -1;
+	}
+	while (fgets(line, sizeof line, f)) {
+		lineno++;
+		size_t len = strlen(line);
+		if (len && line[len - 1] == '\n')
+			line[--len] = '\0';
+		if (!len || line[0] == '#')
+			continue;
+		struct plan_region r = {0};
+		int pass, off = 0;
+		if (sscanf(line, "%d\t%d\t%d\t%d\t%d\t%d\t%n", &pass, &r.x0, &r.y0, &r.x1, &r.y1,
+			   &r.scale, &off) != 6 || !off || !line[off]) {
+			errbuf_printf(err, errlen, "'%s' line %d: expected \"pass x0 y0 x1 y1 scale "
+				      "output\" separated by tabs", path, lineno);
+			goto fail;
+		}
+		if (cnt == alloc) {
+			alloc = alloc ? 2 * alloc : 16;
+			void *a = realloc(*regions, alloc * sizeof(**regions));
+			void *b = a ? realloc(*outputs, alloc * sizeof(**outputs)) : NULL;
+			if (a)
+				*regions = a;
+			if (b)
+				*outputs = b;
+			void *c = b ? realloc(*passes, alloc * sizeof(**passes)) : NULL;
+			if (c)
+				*passes = c;
+			if (!c) {
+				errbuf_printf(err, errlen, "out of memory reading '%s'", path);
+				goto fail;
+			}
+		}
+		(*regions)[cnt] = r;
+		(*passes)[cnt] = pass;
+		(*outputs)[cnt] = strdup(line + off);
+		if (!(*outputs)[cnt]) {
+			errbuf_printf(err, errlen, "out of memory reading '%s'", path);
+			goto fail;
+		}
+		cnt++;
+	}
+	if (ferror(f)) {
+		errbuf_printf(err, errlen, "cannot read '%s': %s", path, strerror(errno));
+		goto fail;
+	}
+	fclose(f);
+	*n = cnt;
+	return 0;
+fail:
+	fclose(f);
+	for (size_t k = 0; k < cnt; k++)
+		free((*outputs)[k]);
+	free(*regions);
+	free(*outputs);
+	free(*passes);
+	*regions = NULL;
+	*outputs = NULL;
+	*passes = NULL;
+	return -1;
+}

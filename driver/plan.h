@@ -1,0 +1,109 @@
+/*
+ * plan.h - decide which pixels get more samples, at which scale, packed
+ * into which rectangles, and write that down for anyone to render.
+ *
+ * The planner works on estimated relative squared errors e_i (see
+ * accum_pixel_error()).  Refining pixel i, which has n_i samples, at its
+ * next unused resolution scale s gives it m = s^2 new samples; the model is
+ * that this divides its error by (n_i + m) / n_i, a gain of
+ * e_i m / (n_i + m) for a cost of m samples.  Pixels are taken in order of
+ * gain per cost until the predicted image relMSE is below the target (with
+ * a margin, so that one pass usually suffices) or the pass's budget is
+ * spent.  The chosen pixels are then packed, per scale, into rectangles:
+ * first the runs of occupied tiles, then, greedily, any two rectangles
+ * whose bounding box costs less than rendering them apart, where a render
+ * costs cost_job (one POV-Ray invocation) plus cost_sample for each of its
+ * area x s^2 samples.  Every pixel of a rectangle gets the new samples,
+ * chosen or not.
+ */
+#ifndef POVPRESS_PLAN_H
+#define POVPRESS_PLAN_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+#include "driver/image.h"
+#include "driver/povray.h"
+
+struct plan_params {
+	double target;		/* image relMSE to reach */
+	double margin;		/* plan for target * margin (default 0.7) */
+	double budget;		/* cost this pass may spend, seconds; 0: no limit */
+	double cost_job;	/* cost of one POV-Ray invocation, seconds */
+	double cost_sample;	/* cost of one sample, seconds */
+	int max_regions;	/* at most this many rectangles (default 64) */
+	int tile;		/* packing grid in pixels (default 8) */
+	double min_gain;	/* a pixel gaining less than min_gain * target
+				 * is not refined (default 0.05) */
+};
+
+void plan_params_init(struct plan_params *p);
+
+struct plan_region {
+	int x0, y0, x1, y1;	/* pixels, inclusive */
+	int scale;		/* resolution scale of the render */
+	long chosen;		/* chosen pixels inside */
+	double gain;		/* predicted reduction of the summed error */
+	double cost;		/* predicted cost, seconds */
+};
+
+enum plan_outcome {
+	PLAN_REFINE,		/* regions to render */
+	PLAN_TARGET_MET,	/* the estimate is at or below the target */
+	PLAN_NO_GAIN,		/* no pixel would gain from more samples */
+	PLAN_NO_BUDGET,		/* the budget cannot pay for one region */
+};
+
+struct plan {
+	int w, h;
+	enum plan_outcome outcome;
+	float *scale;		/* w*h: the scale each pixel is rendered at, 0: none */
+	float *chosen;		/* w*h: 1 where the planner chose the pixel */
+	struct plan_region *regions;
+	size_t nregions;
+	long chosen_pixels;	/* pixels chosen */
+	long pixels;		/* pixels inside regions (that lack their scale) */
+	double samples;		/* samples the regions add */
+	double est_relmse;	/* estimated image relMSE before */
+	double est_after;	/* predicted image relMSE after */
+	double cost;		/* predicted cost, seconds */
+};
+
+/* Short name of an outcome ("refine", "target met", ...); static. */
+const char *plan_outcome_name(enum plan_outcome o);
+
+/*
+ * Estimated relative error of every pixel (w*h doubles into e) from the
+ * analysis (error and fit, as lpr_result or `povpress analyze` give them)
+ * and the accumulation; returns the image relMSE estimate (their mean).
+ */
+double plan_pixel_errors(const struct image *acc, const float *press, const float *fit,
+			 double *e);
+
+/* Plan one pass.  press and fit as for plan_pixel_errors(). */
+int plan_make(const struct image *acc, const float *press, const float *fit,
+	      const struct plan_params *p, struct plan *out, char *err, size_t errlen);
+
+void plan_release(struct plan *pl);
+
+/*
+ * The POV-Ray job for region r of a plan, rendering into output: the
+ * region at r->scale times base, with antialiasing off (appended after the
+ * user's options, which come from base->extra).  base gives the scene,
+ * full size, threads, defines, extra options, work directory and binary;
+ * the job borrows region (storage for the scaled rectangle) and extra
+ * (storage for base->nextra + 1 pointers).
+ */
+void plan_job(const struct pov_job *base, const struct plan_region *r, const char *output,
+	      struct pov_region *region, const char **extra, struct pov_job *job);
+
+/*
+ * The regions file: a header line, then per region a tab-separated line
+ * "pass x0 y0 x1 y1 scale output".  plan_regions_read() fills *regions (you
+ * free() it and *outputs, an array of strings each to free()).
+ */
+int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *outputs);
+int plan_regions_read(const char *path, struct plan_region **regions, char ***outputs,
+		      int **passes, size_t *n, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,1110 @@
+/*
+ * render.c - `povpress render`: the adaptive re-rendering loop.
+ *
+ * base pass -> [analyse -> plan -> region renders -> merge]* -> final image,
+ * error map and report.  Everything that lets a run continue lives in the
+ * work directory: the accumulation (accum.exr, rewritten whole after every
+ * pass), the cost model and the passes so far (progress.txt) and what the
+ * run was asked to do (run.txt, which --resume checks).  The output image
+ * is rewritten after every pass, always through a temporary file, so an
+ * interrupted run leaves either no output or a complete image of its best
+ * result so far.
+ */
+#define _XOPEN_SOURCE 700	/* realpath */
+#include "driver/accum.h"
+#include "driver/commands.h"
+#include "driver/errbuf.h"
+#include "driver/image.h"
+#include "driver/plan.h"
+#include "driver/povray.h"
+#include "regression/lpr.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+static const char usage[] =
+	"usage: povpress render SCENE.pov -o OUT.exr [-W w] [-H h] [--target RELMSE]\n"
+	"                       [--budget SECONDS] [--max-passes N] [--jobs N]\n"
+	"                       [--workdir DIR] [--keep-workdir] [--resume]\n"
+	"                       [--error-map FILE] [--report FILE.json]\n"
+	"                       [--final auto|samples|reconstruction] [-q|-v]\n"
+	"                       [-- POVRAY_OPTIONS...]\n"
+	"\n"
+	"Render SCENE.pov through POV-Ray adaptively: a base pass at one sample per\n"
+	"pixel, then passes that estimate every pixel's error by local regression\n"
+	"(PRESS) and re-render only the regions worth it at 2, 4, 8 and 16 times the\n"
+	"resolution (4 to 256 new samples per pixel), until the estimated image relMSE\n"
+	"reaches the target, the budget is spent, the passes run out, or no pixel\n"
+	"would gain.\n"
+	"\n"
+	"options:\n"
+	"  -o, --output FILE     final image, float RGB EXR (required)\n"
+	"  -W, --width N         image width (default 640)\n"
+	"  -H, --height N        image height (default 480)\n"
+	"  --target RELMSE       estimated relMSE to stop at (default 0.001)\n"
+	"  --budget SECONDS      wall-clock seconds to stop within (default: none)\n"
+	"  --max-passes N        refinement passes after the base pass (default 8)\n"
+	"  --jobs N              POV-Ray processes at once (default 4 per core: each\n"
+	"                        invocation waits ~0.65 s on POV-Ray itself)\n"
+	"  --timeout SECONDS     per POV-Ray run; one retry after a crash or timeout\n"
+	"                        (default: 60 + 20 x the base pass)\n"
+	"  --workdir DIR         keep intermediate files here (default OUT.exr.work)\n"
+	"  --keep-workdir        do not remove the work directory after success\n"
+	"  --resume              continue the run the work directory holds\n"
+	"  --error-map FILE      error map EXR (default OUT.errors.exr): error,\n"
+	"                        relerror, samples, order, bandwidth, pass, scales\n"
+	"  --report FILE         JSON report of every pass (default: none)\n"
+	"  --final MODE          what OUT.exr holds per pixel: auto (the sample mean or\n"
+	"                        the regression's fit, whichever is predicted closer;\n"
+	"                        default), samples, or reconstruction\n"
+	"  -q, --quiet           no progress display\n"
+	"  -v, --verbose         progress and details, even when stderr is not a terminal\n"
+	"  -h, --help            this text\n"
+	"  -- OPTIONS            passed to every POV-Ray run (e.g. Declare=AreaN=4 +WT1);\n"
+	"                        antialiasing options are overridden in region renders\n"
+	"\n"
+	"Exit status: 0 done, 1 failure, 2 bad usage, 130 interrupted (the output then\n"
+	"holds the best image so far, or does not exist; --resume continues).\n";
+
+static double now_s(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static double self_cpu(void)
+{
+	struct rusage ru;
+	if (getrusage(RUSAGE_SELF, &ru))
+		return 0.0;
+	return ru.ru_utime.tv_sec + ru.ru_utime.tv_usec * 1e-6 + ru.ru_stime.tv_sec +
+	       ru.ru_stime.tv_usec * 1e-6;
+}
+
+struct pass_rec {
+	int pass;
+	double wall_s, cpu_s, driver_cpu_s;
+	int invocations, regions, failed;
+	long pixels;
+	double samples;
+	double est_relmse;
+	double analysis_s;
+};
+
+struct run {
+	/* options */
+	const char *scene, *out, *workdir, *error_map, *report;
+	int w, h, max_passes, jobs, quiet, verbose, keep, resume, user_workdir;
+	double target, budget, timeout;
+	enum accum_final final;
+	const char *const *extra;
+	size_t nextra;
+	/* state */
+	int cores, tty;
+	char path[PATH_MAX];
+	double t0, cpu0;
+	double prev_wall, prev_cpu, prev_driver;	/* from a resumed run */
+	double cost_job, cost_sample, latency;
+	int radiosity;
+	struct pass_rec *passes;
+	size_t npasses;
+	const char *stop;
+	struct image acc;
+	/* progress while a pool runs */
+	int pool_done, pool_total, pool_pass;
+};
+
+static void progress(struct run *r, const char *fmt, ...)
+	__attribute__((format(printf, 2, 3)));
+
+static void progress(struct run *r, const char *fmt, ...)
+{
+	if (r->quiet || (!r->tty && !r->verbose))
+		return;
+	va_list ap;
+	va_start(ap, fmt);
+	if (r->tty)
+		fputs("\r\033[K", stderr);
+	vfprintf(stderr, fmt, ap);
+	va_end(ap);
+	if (!r->tty)
+		fputc('\n', stderr);
+	fflush(stderr);
+}
+
+static void progress_end(struct run *r)
+{
+	if (!r->quiet && r->tty)
+		fputc('\n', stderr);
+}
+
+static const char *wpath(struct run *r, const char *name)
+{
+	snprintf(r->path, sizeof r->path, "%s/%s", r->workdir, name);
+	return r->path;
+}
+
+static double elapsed(const struct run *r)
+{
+	return r->prev_wall + now_s() - r->t0;
+}
+
+static int mkdir_p(const char *dir, char *err, size_t errlen)
+{
+	char buf[PATH_MAX];
+	if (snprintf(buf, sizeof buf, "%s", dir) >= (int)sizeof buf) {
+		errbuf_printf(err, errlen, "work directory '%s': path too long", dir);
+		return -1;
+	}
+	for (char *p = buf + 1; *p; p++) {
+		if (*p != '/')
+			continue;
+		*p = '\0';
+		if (mkdir(buf, 0777) && errno != EEXIST) {
+			errbuf_printf(err, errlen, "cannot create '%s': %s", buf, strerror(errno));
+			return -1;
+		}
+		*p = '/';
+	}
+	if (mkdir(buf, 0777) && errno != EEXIST) {
+		errbuf_printf(err, errlen, "cannot create work directory '%s': %s", buf,
+			      strerror(errno));
+		return -1;
+	}
+	return 0;
+}
+
+/* Remove the work directory's files (ours only: nothing below it is a
+ * directory but POV-Ray's link targets, which are links). */
+static void remove_workdir(const char *dir)
+{
+	DIR *d = opendir(dir);
+	if (!d)
+		return;
+	struct dirent *e;
+	char p[PATH_MAX];
+	while ((e = readdir(d))) {
+		if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, ".."))
+			continue;
+		snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
+		unlink(p);
+	}
+	closedir(d);
+	rmdir(dir);
+}
+
+/* What the run was asked to do, for --resume to check. */
+static int run_identity(const struct run *r, char *buf, size_t len)
+{
+	char scene[PATH_MAX];
+	if (!realpath(r->scene, scene))
+		snprintf(scene, sizeof scene, "%s", r->scene);
+	int n = snprintf(buf, len, "scene %s\nsize %dx%d\n", scene, r->w, r->h);
+	for (size_t k = 0; k < r->nextra && n > 0 && (size_t)n < len; k++)
+		n += snprintf(buf + n, len - n, "povray %s\n", r->extra[k]);
+	return n > 0 && (size_t)n < len ? 0 : -1;
+}
+
+static char *slurp(const char *path)
+{
+	FILE *f = fopen(path, "r");
+	if (!f)
+		return NULL;
+	size_t cap = 4096, n = 0;
+	char *s = malloc(cap);
+	while (s) {
+		size_t k = fread(s + n, 1, cap - n - 1, f);
+		n += k;
+		if (n + 1 < cap)
+			break;
+		char *t = realloc(s, cap *= 2);
+		if (!t) {
+			free(s);
+			s = NULL;
+		} else {
+			s = t;
+		}
+	}
+	fclose(f);
+	if (s)
+		s[n] = '\0';
+	return s;
+}
+
+static int write_text_atomic(const char *path, const char *text, char *err, size_t errlen)
+{
+	char tmp[PATH_MAX + 16];
+	snprintf(tmp, sizeof tmp, "%s.tmp", path);
+	FILE *f = fopen(tmp, "w");
+	if (!f) {
+		errbuf_printf(err, errlen, "cannot write '%s': %s", tmp, strerror(errno));
+		return -1;
+	}
+	int bad = fputs(text, f) < 0;
+	bad |= fflush(f) != 0 || fsync(fileno(f)) != 0;
+	bad |= fclose(f) != 0;
+	if (bad || rename(tmp, path)) {
+		errbuf_printf(err, errlen, "cannot write '%s': %s", path, strerror(errno));
+		unlink(tmp);
+		return -1;
+	}
+	return 0;
+}
+
+/* progress.txt: the cost model, then one line per pass. */
+static int save_progress(struct run *r, char *err, size_t errlen)
+{
+	size_t cap = 256 + r->npasses * 256;
+	char *s = malloc(cap);
+	if (!s) {
+		errbuf_printf(err, errlen, "out of memory");
+		return -1;
+	}
+	int n = snprintf(s, cap, "model %.9g %.9g %.9g %d\n", r->cost_job, r->cost_sample,
+			 r->latency, r->radiosity);
+	for (size_t k = 0; k < r->npasses; k++) {
+		const struct pass_rec *p = &r->passes[k];
+		n += snprintf(s + n, cap - n, "pass %d %.6f %.6f %.6f %d %d %d %ld %.17g %.9g %.6f\n",
+			      p->pass, p->wall_s, p->cpu_s, p->driver_cpu_s, p->invocations,
+			      p->regions, p->failed, p->pixels, p->samples, p->est_relmse,
+			      p->analysis_s);
+	}
+	int rc = write_text_atomic(wpath(r, "progress.txt"), s, err, errlen);
+	free(s);
+	return rc;
+}
+
+static int load_progress(struct run *r, char *err, size_t errlen)
+{
+	char *s = slurp(wpath(r, "progress.txt"));
+	if (!s) {
+		errbuf_printf(err, errlen, "cannot resume: '%s' has no finished base pass",
+			      r->workdir);
+		return -1;
+	}
+	int ok = 0;
+	for (char *save = NULL, *line = strtok_r(s, "\n", &save); line;
+	     line = strtok_r(NULL, "\n", &save)) {
+		if (sscanf(line, "model %lf %lf %lf %d", &r->cost_job, &r->cost_sample, &r->latency,
+			   &r->radiosity) == 4) {
+			ok |= 1;
+			continue;
+		}
+		struct pass_rec p = {0};
+		if (sscanf(line, "pass %d %lf %lf %lf %d %d %d %ld %lf %lf %lf", &p.pass, &p.wall_s,
+			   &p.cpu_s, &p.driver_cpu_s, &p.invocations, &p.regions, &p.failed,
+			   &p.pixels, &p.samples, &p.est_relmse, &p.analysis_s) == 11) {
+			void *q = realloc(r->passes, (r->npasses + 1) * sizeof(*r->passes));
+			if (!q)
+				break;
+			r->passes = q;
+			r->passes[r->npasses++] = p;
+			ok |= 2;
+		}
+	}
+	free(s);
+	if (ok != 3) {
+		errbuf_printf(err, errlen, "cannot resume: '%s' is damaged", wpath(r, "progress.txt"));
+		return -1;
+	}
+	for (size_t k = 0; k < r->npasses; k++) {
+		r->prev_wall += r->passes[k].wall_s;
+		r->prev_cpu += r->passes[k].cpu_s;
+		r->prev_driver += r->passes[k].driver_cpu_s;
+	}
+	return 0;
+}
+
+static int add_pass(struct run *r, const struct pass_rec *p)
+{
+	void *q = realloc(r->passes, (r->npasses + 1) * sizeof(*r->passes));
+	if (!q)
+		return -1;
+	r->passes = q;
+	r->passes[r->npasses++] = *p;
+	return 0;
+}
+
+/* The POV-Ray job every render of this run starts from. */
+static void base_job(const struct run *r, struct pov_job *job, const char **extra,
+		     int threads)
+{
+	memset(job, 0, sizeof(*job));
+	job->scene = r->scene;
+	job->width = r->w;
+	job->height = r->h;
+	job->threads = threads;
+	job->extra = extra;
+	job->nextra = r->nextra;
+	job->workdir = r->workdir;
+	for (size_t k = 0; k < r->nextra; k++)
+		extra[k] = r->extra[k];
+}
+
+static void on_done(void *arg, size_t index, const struct pov_result *res)
+{
+	struct run *r = arg;
+	(void)index;
+	(void)res;
+	r->pool_done++;
+	if (r->tty && !r->quiet)
+		progress(r, "pass %d: %d/%d region renders, %.1f s", r->pool_pass, r->pool_done,
+			 r->pool_total, elapsed(r));
+}
+
+/* The analysis the planner and the final image use. */
+static int analyse(struct run *r, struct lpr_result *res, char *err, size_t errlen)
+{
+	size_t npx = (size_t)r->w * r->h;
+	float *rgb = malloc(npx * 3 * sizeof(float));
+	if (!rgb) {
+		errbuf_printf(err, errlen, "out of memory");
+		return -1;
+	}
+	for (size_t i = 0; i < npx; i++) {
+		const float *o = r->acc.px + i * ACC_NCH;
+		for (int c = 0; c < 3; c++)
+			rgb[3 * i + c] = o[ACC_SAMPLES] > 0.0f ? o[c] : NAN;
+	}
+	struct lpr_params p;
+	lpr_params_init(&p);
+	struct lpr_image li = { r->w, r->h, 3, rgb };
+	char lerr[256];
+	int rc = lpr_analyze(&li, NULL, &p, res, lerr, sizeof lerr);
+	if (rc)
+		errbuf_printf(err, errlen, "cannot analyse the image: %s", lerr);
+	free(rgb);
+	return rc;
+}
+
+static int write_output(struct run *r, const struct lpr_result *res, long *took, char *err,
+			size_t errlen)
+{
+	static const char *const rgb_names[3] = { "R", "G", "B" };
+	struct image out = {0};
+	if (image_init(&out, r->w, r->h, 3, rgb_names, err, errlen))
+		return -1;
+	long t = accum_final_image(&r->acc, res->fit, res->error, res->leverage, r->final,
+				   out.px);
+	if (took)
+		*took = t;
+	int rc = image_write_exr(r->out, &out, err, errlen);
+	image_release(&out);
+	return rc;
+}
+
+static int write_error_map(struct run *r, const struct lpr_result *res, char *err,
+			   size_t errlen)
+{
+	static const char *const names[] = {
+		"error", "relerror", "samples", "order", "bandwidth", "pass", "scales",
+	};
+	struct image m = {0};
+	size_t npx = (size_t)r->w * r->h;
+	double *e = malloc(npx * sizeof(double));
+	if (!e || image_init(&m, r->w, r->h, 7, names, err, errlen)) {
+		free(e);
+		if (!e)
+			errbuf_printf(err, errlen, "out of memory");
+		return -1;
+	}
+	plan_pixel_errors(&r->acc, res->error, res->fit, e);
+	for (size_t i = 0; i < npx; i++) {
+		const float *o = r->acc.px + i * ACC_NCH;
+		float *q = m.px + i * 7;
+		double den = 0.0;
+		for (int c = 0; c < 3; c++) {
+			double f = res->fit[3 * i + c];
+			den += (isfinite(f) ? f * f : 0.0) + 0.01;
+		}
+		q[0] = (float)(e[i] * den / 3.0);
+		q[1] = (float)e[i];
+		q[2] = o[ACC_SAMPLES];
+		q[3] = res->order[i];
+		q[4] = res->bandwidth[i];
+		q[5] = o[ACC_PASS];
+		q[6] = o[ACC_SCALES];
+	}
+	free(e);
+	int rc = image_write_exr(r->error_map, &m, err, errlen);
+	image_release(&m);
+	return rc;
+}
+
+static void json_str(FILE *f, const char *s)
+{
+	fputc('"', f);
+	for (; *s; s++) {
+		unsigned char c = (unsigned char)*s;
+		if (c == '"' || c == '\\')
+			fprintf(f, "\\%c", c);
+		else if (c < 0x20)
+			fprintf(f, "\\u%04x", c);
+		else
+			fputc(c, f);
+	}
+	fputc('"', f);
+}
+
+static int write_report(struct run *r, double est, char *err, size_t errlen)
+{
+	char tmp[PATH_MAX + 16];
+	snprintf(tmp, sizeof tmp, "%s.tmp", r->report);
+	FILE *f = fopen(tmp, "w");
+	if (!f) {
+		errbuf_printf(err, errlen, "cannot write report '%s': %s", r->report,
+			      strerror(errno));
+		return -1;
+	}
+	double tw = 0, tc = 0, td = 0, ts = 0;
+	long tp = 0;
+	int ti = 0, tf = 0;
+	fputs("{\n  \"scene\": ", f);
+	json_str(f, r->scene);
+	fprintf(f, ",\n  \"width\": %d,\n  \"height\": %d,\n  \"target\": %.6g,\n", r->w, r->h,
+		r->target);
+	fprintf(f, "  \"budget\": %.6g,\n  \"stop\": ", r->budget);
+	json_str(f, r->stop ? r->stop : "");
+	fprintf(f, ",\n  \"cost_model\": {\"job_s\": %.6g, \"sample_s\": %.6g, "
+		"\"latency_s\": %.6g},\n  \"passes\": [\n", r->cost_job, r->cost_sample,
+		r->latency);
+	for (size_t k = 0; k < r->npasses; k++) {
+		const struct pass_rec *p = &r->passes[k];
+		fprintf(f, "    {\"pass\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, "
+			"\"driver_cpu_s\": %.3f, \"invocations\": %d, \"regions\": %d, "
+			"\"failed\": %d, \"pixels\": %ld, \"samples\": %.0f, "
+			"\"est_relmse\": %.6g, \"analysis_s\": %.3f}%s\n",
+			p->pass, p->wall_s, p->cpu_s, p->driver_cpu_s, p->invocations, p->regions,
+			p->failed, p->pixels, p->samples, p->est_relmse, p->analysis_s,
+			k + 1 < r->npasses ? "," : "");
+		tw += p->wall_s;
+		tc += p->cpu_s;
+		td += p->driver_cpu_s;
+		ti += p->invocations;
+		tf += p->failed;
+		tp += p->pixels;
+		ts += p->samples;
+	}
+	fprintf(f, "  ],\n  \"totals\": {\"passes\": %zu, \"wall_s\": %.3f, \"cpu_s\": %.3f, "
+		"\"driver_cpu_s\": %.3f, \"all_cpu_s\": %.3f, \"invocations\": %d, "
+		"\"failed\": %d, \"pixels\": %ld, \"samples\": %.0f, "
+		"\"samples_per_pixel\": %.4g, \"est_relmse\": %.6g}\n}\n",
+		r->npasses, tw, tc, td, tc + td, ti, tf, tp, ts, ts / ((double)r->w * r->h), est);
+	int bad = ferror(f) != 0;
+	bad |= fclose(f) != 0;
+	if (bad || rename(tmp, r->report)) {
+		errbuf_printf(err, errlen, "cannot write report '%s': %s", r->report,
+			      strerror(errno));
+		unlink(tmp);
+		return -1;
+	}
+	return 0;
+}
+
+/* The base pass: the whole image, one sample per pixel. */
+static int base_pass(struct run *r, char *err, size_t errlen)
+{
+	const char **extra = calloc(r->nextra + 8, sizeof(char *));
+	if (!extra) {
+		errbuf_printf(err, errlen, "out of memory");
+		return -1;
+	}
+	struct pov_job job;
+	base_job(r, &job, extra, r->cores);
+	char radfile[PATH_MAX + 16];
+	char out[PATH_MAX];
+	snprintf(out, sizeof out, "%s", wpath(r, "base.exr"));
+	job.output = out;
+	/* antialiasing off: the base pass is one sample at each pixel centre;
+	 * radiosity, if the scene has any, is saved for the region renders */
+	snprintf(radfile, sizeof radfile, "+RF\"%s\"", wpath(r, "radiosity.rca"));
+	extra[job.nextra++] = "-A";
+	extra[job.nextra++] = "+RFO";
+	extra[job.nextra++] = radfile;
+	struct pov_pool_opts po;
+	pov_pool_opts_init(&po);
+	po.max_jobs = 1;
+	po.timeout_s = r->timeout > 0 ? r->timeout : 0.0;
+	struct pov_result res = {0};
+	double t = now_s(), c = self_cpu();
+	progress(r, "base pass: %dx%d, 1 sample per pixel", r->w, r->h);
+	int rc = pov_pool_run(&job, 1, &po, &res, err, errlen);
+	int ret = -1;
+	if (rc == POV_INTERRUPTED) {
+		errbuf_printf(err, errlen, "interrupted during the base pass");
+		ret = POV_INTERRUPTED;
+		goto out;
+	}
+	if (rc)
+		goto out;
+	if (res.status != POV_OK) {
+		errbuf_printf(err, errlen, "the base pass of '%s' failed: %s", r->scene,
+			      res.message);
+		goto out;
+	}
+	struct image img = {0};
+	if (image_read_exr(out, &img, err, errlen))
+		goto out;
+	rc = accum_from_base(&img, out, &r->acc, err, errlen);
+	image_release(&img);
+	if (rc)
+		goto out;
+	/* the cost model */
+	const struct pov_stats *st = &res.stats;
+	double trace = (st->have & POV_HAVE_TRACE) ? st->trace.cpu_s : res.cpu_s;
+	double rays = st->rays > 0 ? (double)st->rays : (double)r->w * r->h;
+	r->cost_sample = trace / rays;
+	if (!(r->cost_sample > 1e-9))
+		r->cost_sample = 1e-9;
+	double setup = res.cpu_s - trace;
+	r->latency = res.wall_s - ((st->have & POV_HAVE_TRACE) ? st->trace.wall_s : 0.0) -
+		     ((st->have & POV_HAVE_PARSE) ? st->parse.wall_s : 0.0) -
+		     ((st->have & POV_HAVE_RADIOSITY) ? st->radiosity.wall_s : 0.0);
+	if (r->latency < 0.0)
+		r->latency = 0.0;
+	r->radiosity = (st->have & POV_HAVE_RADIOSITY) != 0;
+	/* a region render repeats the setup (parse, bounding) and waits on
+	 * POV-Ray's latency in one of the pool's slots: in core-seconds that
+	 * is the latency times cores over slots */
+	r->cost_job = (setup > 0.0 ? setup : 0.0) + r->latency * r->cores / r->jobs;
+	if (r->timeout <= 0.0)
+		r->timeout = 60.0 + 20.0 * res.wall_s;
+	struct pass_rec p = {0};
+	p.pass = 0;
+	p.wall_s = now_s() - t;
+	p.cpu_s = res.cpu_s;
+	p.invocations = res.attempts;
+	p.regions = 1;
+	p.pixels = (long)r->w * r->h;
+	p.samples = (double)r->w * r->h;
+	p.driver_cpu_s = self_cpu() - c;
+	p.est_relmse = NAN;	/* filled in by the first analysis */
+	if (add_pass(r, &p)) {
+		errbuf_printf(err, errlen, "out of memory");
+		goto out;
+	}
+	if (r->verbose)
+		fprintf(stderr, "povpress render: base pass %.2f s wall, %.2f s CPU; cost model: "
+			"%.3g s per sample, %.3g s per invocation (latency %.2f s)%s\n",
+			p.wall_s, p.cpu_s, r->cost_sample, r->cost_job, r->latency,
+			r->radiosity ? "; radiosity saved for the region renders" : "");
+	ret = 0;
+out:
+	pov_result_release(&res);
+	free(extra);
+	return ret;
+}
+
+/*
+ * One refinement pass from the analysis res.  Returns 0 when a pass ran,
+ * PASS_STOP when the planner stopped the run (r->stop says why), -1 on
+ * failure, POV_INTERRUPTED when a signal came.
+ */
+enum { PASS_STOP = 2 };
+static int refine_pass(struct run *r, int pass, const struct lpr_result *res, char *err,
+		       size_t errlen)
+{
+	double t = now_s(), c = self_cpu();
+	struct plan_params pp;
+	plan_params_init(&pp);
+	pp.target = r->target;
+	pp.cost_job = r->cost_job;
+	pp.cost_sample = r->cost_sample;
+	pp.max_regions = 4 * r->jobs > 16 ? 4 * r->jobs : 16;
+	if (r->budget > 0.0) {
+		double left = r->budget - elapsed(r);
+		/* in core-seconds, keeping a share for the analysis and the
+		 * latency of the pass's last round of jobs */
+		pp.budget = (left - r->latency - 0.2) * r->cores * 0.8;
+		if (pp.budget <= 0.0) {
+			r->stop = "budget spent";
+			return PASS_STOP;
+		}
+	}
+	struct plan pl;
+	if (plan_make(&r->acc, res->error, res->fit, &pp, &pl, err, errlen))
+		return -1;
+	if (pl.outcome != PLAN_REFINE) {
+		r->stop = plan_outcome_name(pl.outcome);
+		plan_release(&pl);
+		return PASS_STOP;
+	}
+	size_t n = pl.nregions;
+	struct pov_job *jobs = calloc(n, sizeof(*jobs));
+	struct pov_region *regs = calloc(n, sizeof(*regs));
+	const char **extras = calloc(n * (r->nextra + 4), sizeof(char *));
+	char **outs = calloc(n, sizeof(char *));
+	struct pov_result *results = calloc(n, sizeof(*results));
+	const char **bextra = calloc(r->nextra + 4, sizeof(char *));
+	char radfile[PATH_MAX + 16];
+	int ret = -1;
+	if (!jobs || !regs || !extras || !outs || !results || !bextra) {
+		errbuf_printf(err, errlen, "out of memory");
+		goto out;
+	}
+	struct pov_job base;
+	base_job(r, &base, bextra, 1);
+	if (r->radiosity) {
+		snprintf(radfile, sizeof radfile, "+RF\"%s\"", wpath(r, "radiosity.rca"));
+		bextra[base.nextra++] = "+RFI";
+		bextra[base.nextra++] = radfile;
+	}
+	for (size_t k = 0; k < n; k++) {
+		char name[64];
+		snprintf(name, sizeof name, "p%02d-r%03zu-s%d.exr", pass, k, pl.regions[k].scale);
+		outs[k] = strdup(wpath(r, name));
+		if (!outs[k]) {
+			errbuf_printf(err, errlen, "out of memory");
+			goto out;
+		}
+		plan_job(&base, &pl.regions[k], outs[k], &regs[k], extras + k * (r->nextra + 4),
+			 &jobs[k]);
+	}
+	/* what this pass renders, for inspection and for running elsewhere */
+	{
+		FILE *f = fopen(wpath(r, "regions.tsv"), "w");
+		if (f) {
+			plan_regions_write(f, &pl, pass, outs);
+			fclose(f);
+		}
+	}
+	struct pov_pool_opts po;
+	pov_pool_opts_init(&po);
+	po.max_jobs = r->jobs < (int)n ? r->jobs : (int)n;
+	po.timeout_s = r->timeout;
+	po.on_done = on_done;
+	po.arg = r;
+	r->pool_done = 0;
+	r->pool_total = (int)n;
+	r->pool_pass = pass;
+	progress(r, "pass %d: %zu regions, %ld pixels, %.0f samples", pass, n, pl.pixels,
+		 pl.samples);
+	int rc = pov_pool_run(jobs, n, &po, results, err, errlen);
+	if (rc < 0)
+		goto out;
+	struct pass_rec p = {0};
+	p.pass = pass;
+	for (size_t k = 0; k < n; k++) {
+		const struct plan_region *g = &pl.regions[k];
+		p.cpu_s += results[k].cpu_s;
+		p.invocations += results[k].attempts;
+		if (results[k].status != POV_OK) {
+			if (results[k].status != POV_CANCELLED) {
+				p.failed++;
+				fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s%s%s\n",
+					pass, g->x0, g->y0, g->x1, g->y1,
+					pov_status_name(results[k].status),
+					results[k].message[0] ? ": " : "", results[k].message);
+			}
+			continue;
+		}
+		struct image img = {0};
+		int oy = 0;
+		long folded = 0;
+		int s = g->scale;
+		if (image_read_exr_rows(outs[k], g->y0 * s, (g->y1 + 1) * s - 1, &img, &oy, err,
+					errlen) ||
+		    accum_merge_region(&r->acc, &img, oy, s, g->x0, g->y0, g->x1, g->y1, pass,
+				       &folded, err, errlen)) {
+			fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n", pass,
+				g->x0, g->y0, g->x1, g->y1, err);
+			p.failed++;
+			image_release(&img);
+			continue;
+		}
+		image_release(&img);
+		p.regions++;
+		p.pixels += folded;
+		p.samples += (double)folded * s * s;
+		if (!r->keep)
+			unlink(outs[k]);
+	}
+	p.wall_s = now_s() - t;
+	p.driver_cpu_s = self_cpu() - c;
+	p.est_relmse = NAN;
+	if (add_pass(r, &p)) {
+		errbuf_printf(err, errlen, "out of memory");
+		goto out;
+	}
+	if (image_write_exr(wpath(r, "accum.exr"), &r->acc, err, errlen) ||
+	    save_progress(r, err, errlen))
+		goto out;
+	ret = rc == POV_INTERRUPTED ? POV_INTERRUPTED : 0;
+	if (ret)
+		errbuf_printf(err, errlen, "interrupted in pass %d", pass);
+out:
+	for (size_t k = 0; k < n; k++) {
+		if (results)
+			pov_result_release(&results[k]);
+		if (outs)
+			free(outs[k]);
+	}
+	free(jobs);
+	free(regs);
+	free(extras);
+	free(outs);
+	free(results);
+	free(bextra);
+	plan_release(&pl);
+	return ret;
+}
+
+static int parse_double(const char *s, double lo, double hi, double *out)
+{
+	char *end;
+	errno = 0;
+	double v = strtod(s, &end);
+	if (errno || end == s || *end || !(v >= lo && v <= hi))
+		return -1;
+	*out = v;
+	return 0;
+}
+
+static int parse_int(const char *s, int lo, int hi, int *out)
+{
+	char *end;
+	errno = 0;
+	long v = strtol(s, &end, 10);
+	if (errno || end == s || *end || v < lo || v > hi)
+		return -1;
+	*out = (int)v;
+	return 0;
+}
+
+/* Check that path's directory exists and is writable, before any work. */
+static int check_writable(const char *what, const char *path, char *err, size_t errlen)
+{
+	char dir[PATH_MAX];
+	snprintf(dir, sizeof dir, "%s", path);
+	char *slash = strrchr(dir, '/');
+	if (!slash)
+		snprintf(dir, sizeof dir, ".");
+	else if (slash == dir)
+		dir[1] = '\0';
+	else
+		*slash = '\0';
+	struct stat st;
+	if (stat(dir, &st) || !S_ISDIR(st.st_mode)) {
+		errbuf_printf(err, errlen, "cannot write %s '%s': directory '%s' does not exist",
+			      what, path, dir);
+		return -1;
+	}
+	if (access(dir, W_OK | X_OK)) {
+		errbuf_printf(err, errlen, "cannot write %s '%s': %s", what, path,
+			      strerror(errno));
+		return -1;
+	}
+	if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
+		errbuf_printf(err, errlen, "cannot write %s '%s': it is a directory", what, path);
+		return -1;
+	}
+	return 0;
+}
+
+int cmd_render(int argc, char **argv)
+{
+	struct run r;
+	memset(&r, 0, sizeof r);
+	r.w = 640;
+	r.h = 480;
+	r.target = 1e-3;
+	r.max_passes = 8;
+	r.final = ACC_FINAL_AUTO;
+	char emap[PATH_MAX], wdir[PATH_MAX];
+
+	int i = 1;
+	for (; i < argc; i++) {
+		const char *a = argv[i];
+		int more = i + 1 < argc;
+		if (!strcmp(a, "--")) {
+			i++;
+			break;
+		} else if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+			fputs(usage, stdout);
+			return 0;
+		} else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
+			r.quiet = 1;
+		} else if (!strcmp(a, "-v") || !strcmp(a, "--verbose")) {
+			r.verbose = 1;
+		} else if (!strcmp(a, "--keep-workdir")) {
+			r.keep = 1;
+		} else if (!strcmp(a, "--resume")) {
+			r.resume = 1;
+		} else if (!more && a[0] == '-') {
+			fprintf(stderr, "povpress render: unknown option or missing value '%s'\n%s", a,
+				usage);
+			return 2;
+		} else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+			r.out = argv[++i];
+		} else if (!strcmp(a, "-W") || !strcmp(a, "--width")) {
+			if (parse_int(argv[++i], 1, 65535, &r.w))
+				goto bad;
+		} else if (!strcmp(a, "-H") || !strcmp(a, "--height")) {
+			if (parse_int(argv[++i], 1, 65535, &r.h))
+				goto bad;
+		} else if (!strcmp(a, "--target")) {
+			if (parse_double(argv[++i], 1e-12, 1e6, &r.target))
+				goto bad;
+		} else if (!strcmp(a, "--budget")) {
+			if (parse_double(argv[++i], 1e-3, 1e9, &r.budget))
+				goto bad;
+		} else if (!strcmp(a, "--timeout")) {
+			if (parse_double(argv[++i], 1e-3, 1e9, &r.timeout))
+				goto bad;
+		} else if (!strcmp(a, "--max-passes")) {
+			if (parse_int(argv[++i], 0, 1000, &r.max_passes))
+				goto bad;
+		} else if (!strcmp(a, "--jobs") || !strcmp(a, "-j")) {
+			if (parse_int(argv[++i], 1, 1024, &r.jobs))
+				goto bad;
+		} else if (!strcmp(a, "--workdir")) {
+			r.workdir = argv[++i];
+			r.user_workdir = 1;
+		} else if (!strcmp(a, "--error-map")) {
+			r.error_map = argv[++i];
+		} else if (!strcmp(a, "--report")) {
+			r.report = argv[++i];
+		} else if (!strcmp(a, "--final")) {
+			const char *m = argv[++i];
+			if (!strcmp(m, "auto"))
+				r.final = ACC_FINAL_AUTO;
+			else if (!strcmp(m, "samples"))
+				r.final = ACC_FINAL_SAMPLES;
+			else if (!strcmp(m, "reconstruction"))
+				r.final = ACC_FINAL_RECONSTRUCTION;
+			else
+				goto bad;
+		} else if (a[0] == '-' && a[1]) {
+			fprintf(stderr, "povpress render: unknown option '%s'\n%s", a, usage);
+			return 2;
+		} else if (!r.scene) {
+			r.scene = a;
+		} else {
+			fprintf(stderr, "povpress render: unexpected argument '%s' (POV-Ray options go "
+				"after --)\n%s", a, usage);
+			return 2;
+		}
+		continue;
+bad:
+		fprintf(stderr, "povpress render: bad value '%s' for %s\n", argv[i], a);
+		return 2;
+	}
+	r.extra = (const char *const *)argv + i;
+	r.nextra = (size_t)(argc - i);
+	if (!r.scene || !r.out) {
+		fprintf(stderr, "povpress render: %s\n%s",
+			!r.scene ? "no scene given" : "no output given (-o OUT.exr)", usage);
+		return 2;
+	}
+	if (!r.error_map) {
+		size_t len = strlen(r.out);
+		if (len > 4 && !strcmp(r.out + len - 4, ".exr"))
+			len -= 4;
+		snprintf(emap, sizeof emap, "%.*s.errors.exr", (int)len, r.out);
+		r.error_map = emap;
+	}
+	if (!r.workdir) {
+		snprintf(wdir, sizeof wdir, "%s.work", r.out);
+		r.workdir = wdir;
+	}
+	r.cores = pov_cpu_count();
+	if (!r.jobs)
+		r.jobs = 4 * r.cores;
+	r.tty = isatty(2);
+
+	char err[1024];
+	int ret = 1;
+	struct lpr_result res = {0};
+	struct stat st;
+	if (stat(r.scene, &st) || !S_ISREG(st.st_mode)) {
+		errbuf_printf(err, sizeof err, "cannot read scene '%s': %s", r.scene,
+			      errno ? strerror(errno) : "not a regular file");
+		if (!stat(r.scene, &st))
+			errbuf_printf(err, sizeof err, "cannot read scene '%s': not a regular file",
+				      r.scene);
+		goto fail_early;
+	}
+	if (access(r.scene, R_OK)) {
+		errbuf_printf(err, sizeof err, "cannot read scene '%s': %s", r.scene,
+			      strerror(errno));
+		goto fail_early;
+	}
+	{
+		struct pov_job probe = { .scene = r.scene };
+		char bin[PATH_MAX];
+		if (pov_find_binary(&probe, bin, sizeof bin, err, sizeof err))
+			goto fail_early;
+	}
+	if (check_writable("output", r.out, err, sizeof err) ||
+	    check_writable("error map", r.error_map, err, sizeof err) ||
+	    (r.report && check_writable("report", r.report, err, sizeof err)))
+		goto fail_early;
+	if (pov_signals_catch(err, sizeof err))
+		goto fail_early;
+
+	r.t0 = now_s();
+	r.cpu0 = self_cpu();
+	char ident[8192];
+	if (run_identity(&r, ident, sizeof ident)) {
+		errbuf_printf(err, sizeof err, "too many POV-Ray options");
+		goto fail;
+	}
+	int first_pass = 1;
+	if (r.resume) {
+		char *old = slurp(wpath(&r, "run.txt"));
+		if (!old) {
+			errbuf_printf(err, sizeof err, "cannot resume: no run in work directory '%s'",
+				      r.workdir);
+			goto fail;
+		}
+		int same = !strcmp(old, ident);
+		free(old);
+		if (!same) {
+			errbuf_printf(err, sizeof err, "cannot resume: work directory '%s' holds a "
+				      "run of another scene, size or POV-Ray options (see its run.txt)",
+				      r.workdir);
+			goto fail;
+		}
+		if (load_progress(&r, err, sizeof err) ||
+		    accum_read(wpath(&r, "accum.exr"), &r.acc, err, sizeof err))
+			goto fail;
+		if (r.acc.w != r.w || r.acc.h != r.h) {
+			errbuf_printf(err, sizeof err, "cannot resume: the accumulation in '%s' is "
+				      "%dx%d", r.workdir, r.acc.w, r.acc.h);
+			goto fail;
+		}
+		first_pass = r.passes[r.npasses - 1].pass + 1;
+		if (r.timeout <= 0.0)
+			r.timeout = 60.0 + 20.0 * r.passes[0].wall_s;
+		progress(&r, "resuming after pass %d (%.1f s so far)", first_pass - 1, r.prev_wall);
+	} else {
+		if (mkdir_p(r.workdir, err, sizeof err))
+			goto fail_early;
+		/* a fresh run: forget a previous one here */
+		unlink(wpath(&r, "progress.txt"));
+		unlink(wpath(&r, "accum.exr"));
+		if (write_text_atomic(wpath(&r, "run.txt"), ident, err, sizeof err))
+			goto fail;
+		int brc = base_pass(&r, err, sizeof err);
+		if (brc && !r.user_workdir && !r.keep)
+			remove_workdir(r.workdir);	/* nothing in it worth resuming */
+		if (brc == POV_INTERRUPTED)
+			goto interrupted;
+		if (brc)
+			goto fail;
+		if (image_write_exr(wpath(&r, "accum.exr"), &r.acc, err, sizeof err) ||
+		    save_progress(&r, err, sizeof err))
+			goto fail;
+	}
+
+	/* refinement passes */
+	int pass = first_pass;
+	for (;;) {
+		double ta = now_s();
+		lpr_result_release(&res);
+		if (analyse(&r, &res, err, sizeof err))
+			goto fail;
+		size_t npx = (size_t)r.w * r.h;
+		double *e = malloc(npx * sizeof(double));
+		if (!e) {
+			errbuf_printf(err, sizeof err, "out of memory");
+			goto fail;
+		}
+		double est = plan_pixel_errors(&r.acc, res.error, res.fit, e);
+		long left = 0;
+		for (size_t k = 0; k < npx; k++)
+			left += e[k] > r.target;
+		free(e);
+		struct pass_rec *last = &r.passes[r.npasses - 1];
+		last->est_relmse = est;
+		last->analysis_s = now_s() - ta;
+		last->wall_s += last->analysis_s;
+		if (save_progress(&r, err, sizeof err) ||
+		    write_output(&r, &res, NULL, err, sizeof err))
+			goto fail;
+		double el = elapsed(&r);
+		if (r.budget > 0.0)
+			progress(&r, "pass %d: estimated relMSE %.3g (target %.3g), %ld pixels above "
+				 "it, %.1f s elapsed, %.1f s left", last->pass, est, r.target, left, el,
+				 r.budget - el > 0 ? r.budget - el : 0.0);
+		else
+			progress(&r, "pass %d: estimated relMSE %.3g (target %.3g), %ld pixels above "
+				 "it, %.1f s elapsed", last->pass, est, r.target, left, el);
+		progress_end(&r);
+		if (pov_signal_received())
+			goto interrupted;
+		if (pass > r.max_passes) {
+			r.stop = "max passes";
+			break;
+		}
+		int rc = refine_pass(&r, pass, &res, err, sizeof err);
+		if (rc == POV_INTERRUPTED) {
+			/* what finished is merged and saved: show it */
+			lpr_result_release(&res);
+			if (analyse(&r, &res, err, sizeof err) == 0)
+				write_output(&r, &res, NULL, err, sizeof err);
+			goto interrupted;
+		}
+		if (rc < 0)
+			goto fail;
+		if (rc == PASS_STOP)
+			break;
+		pass++;
+	}
+
+	/* the final image, error map and report */
+	long took = 0;
+	if (write_output(&r, &res, &took, err, sizeof err) ||
+	    write_error_map(&r, &res, err, sizeof err))
+		goto fail;
+	double est = r.passes[r.npasses - 1].est_relmse;
+	if (r.report && write_report(&r, est, err, sizeof err))
+		goto fail;
+	if (!r.quiet && (r.tty || r.verbose)) {
+		double cpu = 0.0;
+		for (size_t k = 0; k < r.npasses; k++)
+			cpu += r.passes[k].cpu_s + r.passes[k].driver_cpu_s;
+		fprintf(stderr, "povpress render: %s after %zu passes: estimated relMSE %.3g, "
+			"%.1f s, %.1f CPU s; %s (%ld of %d pixels from the fit)\n", r.stop,
+			r.npasses - 1, est, elapsed(&r), cpu, r.out, took, r.w * r.h);
+	}
+	if (!r.keep && !r.user_workdir)
+		remove_workdir(r.workdir);
+	ret = 0;
+	goto done;
+
+interrupted:
+	progress_end(&r);
+	fprintf(stderr, "povpress render: interrupted (signal %d); %s; the work is in '%s' "
+		"(--resume continues)\n", pov_signal_received(),
+		access(r.out, F_OK) == 0 ? "the output holds the best image so far" :
+					   "no output written",
+		r.workdir);
+	ret = 130;
+	goto done;
+fail:
+	progress_end(&r);
+	fprintf(stderr, "povpress render: %s\n", err);
+	ret = 1;
+	goto done;
+fail_early:
+	fprintf(stderr, "povpress render: %s\n", err);
+	return 1;
+done:
+	pov_signals_restore();
+	lpr_result_release(&res);
+	image_release(&r.acc);
+	free(r.passes);
+	return ret;
+}
