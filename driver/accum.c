@@ -212,9 +212,14 @@ double accum_contrast(const struct image *acc, size_t i, const float fit[3])
 				continue;
 			double d2 = 0.0;
 			for (int c = 0; c < 3; c++) {
-				double f = isfinite(fit[c]) ? fit[c] : o[c];
+				/* relative to the brighter side: what an edge could
+				 * move this pixel by, relative to what it would then be
+				 * (a dark pixel beside a light source must not count
+				 * the light's brightness over its own darkness) */
+				double f = isfinite(fit[c]) ? fabs(fit[c]) : fabs(o[c]);
+				double g = fabs((double)q[c]) > f ? fabs((double)q[c]) : f;
 				double d = (double)q[c] - o[c];
-				d2 += d * d / (f * f + METRICS_RELMSE_EPS) / 3.0;
+				d2 += d * d / (g * g + METRICS_RELMSE_EPS) / 3.0;
 			}
 			if (d2 > best)
 				best = d2;
@@ -246,7 +251,12 @@ double accum_pixel_error(const struct image *acc, size_t i, double press, const 
 	 * s x s samples places an edge with an error of up to 1/(2s) of the
 	 * pixel, uniform, so its squared error is contrast^2 / (12 s^2) */
 	int s = finest_scale(acc, i);
-	double edge = contrast / (12.0 * s * s);
+	/* a smooth gradient also differs from its neighbours, by about the
+	 * spread of the pixel's own samples (a linear ramp of height d has
+	 * sample variance d^2 / 12; twice that allows for diagonals): only the
+	 * contrast the samples do not show can hide an edge */
+	double hidden = contrast - (n >= 4.0 ? 24.0 * vrel : 0.0);
+	double edge = hidden > 0.0 ? hidden / (12.0 * s * s) : 0.0;
 	if (edge > e)
 		e = edge;
 	if (n <= 0.0)
@@ -273,14 +283,20 @@ long accum_final_image(const struct image *acc, const float *fit, const float *p
 			use_fit = 1;
 		else {
 			double h = leverage[i], e = press[i];
-			if (!isfinite(h) || !isfinite(e) || h < 0.0 || h > 1.0) {
+			if (!isfinite(h) || !isfinite(e) || h < 0.0 || h > 1.0 || n < 4.0) {
 				use_fit = 0;
 			} else {
 				double v = e / (1.0 + h);
 				if (n >= 4.0)
 					v = (o[ACC_VAR_R] + o[ACC_VAR_G] + o[ACC_VAR_B]) / 3.0 / n;
 				double bias = e - v > 0.0 ? e - v : 0.0;
-				use_fit = h * h * v + (1.0 - h) * (1.0 - h) * bias < v;
+				double d2 = 0.0;
+				for (int c = 0; c < 3; c++)
+					d2 += ((double)f[c] - o[c]) * ((double)f[c] - o[c]) / 3.0;
+				/* and only a fit within two standard deviations of the
+				 * samples: a fit further off has bias the smoothed PRESS
+				 * did not see (a highlight, an edge) */
+				use_fit = h * h * v + (1.0 - h) * (1.0 - h) * bias < v && d2 <= 4.0 * v;
 			}
 		}
 		for (int c = 0; c < 3; c++)

@@ -76,8 +76,9 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 
 /*
  * The largest relative squared difference between pixel i's mean and one
- * of its eight neighbours' (mean over R, G, B of difference^2 over
- * fit^2 + 0.01): how much an edge through the pixel could be worth.
+ * of its eight neighbours' (mean over R, G, B of difference^2 over the
+ * brighter one's value^2 + 0.01): how much an edge through the pixel could
+ * be worth.
  */
 double accum_contrast(const struct image *acc, size_t i, const float fit[3]);
 
@@ -112,7 +113,8 @@ enum accum_final {
  * mean (the sample variance over n once n >= 4, else the PRESS error over
  * 1 + H, what it is for pure noise) and H the pixel's leverage, the fit
  * H Y + (1 - H) f(-i) is expected to miss by H^2 v + (1 - H)^2 (press - v),
- * the samples by v; the smaller wins.  Pixels without a finite fit keep
+ * the samples by v; the fit wins when it is smaller and the fit lies
+ * within two standard deviations (2 sqrt(v)) of the samples' mean.  Pixels without a finite fit keep
  * their samples, pixels without samples take the fit.
  */
 long accum_final_image(const struct image *acc, const float *fit, const float *press,

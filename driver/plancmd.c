@@ -53,6 +53,8 @@ static const char plan_usage[] =
 	"  --threads N         POV-Ray threads per job, +WT (default 1)\n"
 	"  --radiosity FILE    radiosity data the base pass saved (+RFO): jobs load it\n"
 	"  -- OPTIONS          passed to every POV-Ray job (as given to the base pass)\n"
+	"Every job also gets Declare=POVPRESS_PASS=N (the base pass had 0), which a\n"
+	"scene can test to load what its base pass saved (radiosity, photons).\n"
 	"  -h, --help          this text\n"
 	"\n"
 	"Prints the outcome and the estimated relMSE; exits 0 also when nothing needs\n"
@@ -304,6 +306,11 @@ bad:
 	for (size_t k = 0; k < nextra; k++)
 		extra[k] = argv[i + (int)k];
 	base.nextra = nextra;
+	char passno[16];
+	snprintf(passno, sizeof passno, "%d", pass);
+	const struct pov_define pd = { "POVPRESS_PASS", passno };
+	base.defines = &pd;
+	base.ndefines = 1;
 	char radopt[PATH_MAX + 8];
 	if (radiosity) {
 		snprintf(radopt, sizeof radopt, "+RF\"%s\"", radiosity);

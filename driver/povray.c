@@ -228,6 +228,41 @@ static int make_link(const char *workdir, const char *target, const char *suffix
 	return -1;
 }
 
+int pov_path_safe(const char *path)
+{
+	return path_safe(path);
+}
+
+int pov_safe_dir(const char *dir, char *out, size_t outlen, char *err, size_t errlen)
+{
+	char real[PATH_MAX];
+
+	if (path_safe(dir)) {
+		if (snprintf(out, outlen, "%s", dir) >= (int)outlen) {
+			errbuf_printf(err, errlen, "directory '%s': path too long", dir);
+			return -1;
+		}
+		return 0;
+	}
+	if (!realpath(dir, real)) {
+		errbuf_printf(err, errlen, "cannot use directory '%s': %s", dir, strerror(errno));
+		return -1;
+	}
+	const char *tmp = getenv("TMPDIR");
+	if (!tmp || !*tmp || !path_safe(tmp))
+		tmp = "/tmp";
+	char *link = NULL;
+	int rc = make_link(tmp, real, ".d", dir, &link, err, errlen);
+	if (rc)
+		return -1;
+	if (snprintf(out, outlen, "%s", link) >= (int)outlen) {
+		errbuf_printf(err, errlen, "directory '%s': path too long", link);
+		rc = -1;
+	}
+	free(link);
+	return rc;
+}
+
 /* ---- commands ------------------------------------------------------- */
 
 #define MAX_SUBS 3

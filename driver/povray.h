@@ -173,6 +173,18 @@ int pov_shell_line(const struct pov_job *job, char **line_out, char *err, size_t
 int pov_find_binary(const struct pov_job *job, char *path, size_t pathlen, char *err,
 		    size_t errlen);
 
+/* Whether POV-Ray can be given path in double quotes (printable ASCII,
+ * no double quote). */
+int pov_path_safe(const char *path);
+
+/*
+ * A path POV-Ray can be given for directory dir: dir itself when it is
+ * safe, else a symbolic link to it in $TMPDIR (or /tmp) named after a
+ * hash of its real path, made or reused.  For work directories whose own
+ * path has a double quote or a non-ASCII byte.
+ */
+int pov_safe_dir(const char *dir, char *out, size_t outlen, char *err, size_t errlen);
+
 /* ---- the pool ------------------------------------------------------- */
 
 enum pov_status {

@@ -64,9 +64,10 @@ static const char usage[] =
 	"  --error-map FILE      error map EXR (default OUT.errors.exr): error,\n"
 	"                        relerror, samples, order, bandwidth, pass, scales\n"
 	"  --report FILE         JSON report of every pass (default: none)\n"
-	"  --final MODE          what OUT.exr holds per pixel: auto (the sample mean or\n"
-	"                        the regression's fit, whichever is predicted closer;\n"
-	"                        default), samples, or reconstruction\n"
+	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
+	"                        pixel's samples; default), auto (the sample mean or the\n"
+	"                        regression's fit, whichever is predicted closer), or\n"
+	"                        reconstruction (the fit everywhere); see the README\n"
 	"  -q, --quiet           no progress display\n"
 	"  -v, --verbose         progress and details, even when stderr is not a terminal\n"
 	"  -h, --help            this text\n"
@@ -105,6 +106,7 @@ struct pass_rec {
 struct run {
 	/* options */
 	const char *scene, *out, *workdir, *error_map, *report;
+	char povdir[PATH_MAX];	/* workdir as POV-Ray can be told it */
 	int w, h, max_passes, jobs, quiet, verbose, keep, resume, user_workdir;
 	double target, budget, timeout;
 	enum accum_final final;
@@ -347,7 +349,7 @@ static void base_job(const struct run *r, struct pov_job *job, const char **extr
 	job->threads = threads;
 	job->extra = extra;
 	job->nextra = r->nextra;
-	job->workdir = r->workdir;
+	job->workdir = r->povdir;
 	for (size_t k = 0; k < r->nextra; k++)
 		extra[k] = r->extra[k];
 }
@@ -522,13 +524,16 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	}
 	struct pov_job job;
 	base_job(r, &job, extra, r->cores);
-	char radfile[PATH_MAX + 16];
+	char radfile[PATH_MAX + 32];
 	char out[PATH_MAX];
 	snprintf(out, sizeof out, "%s", wpath(r, "base.exr"));
 	job.output = out;
+	const struct pov_define pd = { "POVPRESS_PASS", "0" };
+	job.defines = &pd;
+	job.ndefines = 1;
 	/* antialiasing off: the base pass is one sample at each pixel centre;
 	 * radiosity, if the scene has any, is saved for the region renders */
-	snprintf(radfile, sizeof radfile, "+RF\"%s\"", wpath(r, "radiosity.rca"));
+	snprintf(radfile, sizeof radfile, "+RF\"%s/radiosity.rca\"", r->povdir);
 	extra[job.nextra++] = "-A";
 	extra[job.nextra++] = "+RFO";
 	extra[job.nextra++] = radfile;
@@ -647,7 +652,7 @@ static int refine_pass(struct run *r, int pass, const struct lpr_result *res, ch
 	char **outs = calloc(n, sizeof(char *));
 	struct pov_result *results = calloc(n, sizeof(*results));
 	const char **bextra = calloc(r->nextra + 4, sizeof(char *));
-	char radfile[PATH_MAX + 16];
+	char radfile[PATH_MAX + 32];
 	int ret = -1;
 	if (!jobs || !regs || !extras || !outs || !results || !bextra) {
 		errbuf_printf(err, errlen, "out of memory");
@@ -655,8 +660,13 @@ static int refine_pass(struct run *r, int pass, const struct lpr_result *res, ch
 	}
 	struct pov_job base;
 	base_job(r, &base, bextra, 1);
+	char passno[16];
+	snprintf(passno, sizeof passno, "%d", pass);
+	const struct pov_define pd = { "POVPRESS_PASS", passno };
+	base.defines = &pd;
+	base.ndefines = 1;
 	if (r->radiosity) {
-		snprintf(radfile, sizeof radfile, "+RF\"%s\"", wpath(r, "radiosity.rca"));
+		snprintf(radfile, sizeof radfile, "+RF\"%s/radiosity.rca\"", r->povdir);
 		bextra[base.nextra++] = "+RFI";
 		bextra[base.nextra++] = radfile;
 	}
@@ -820,7 +830,7 @@ int cmd_render(int argc, char **argv)
 	r.h = 480;
 	r.target = 1e-3;
 	r.max_passes = 8;
-	r.final = ACC_FINAL_AUTO;
+	r.final = ACC_FINAL_SAMPLES;
 	char emap[PATH_MAX], wdir[PATH_MAX];
 
 	int i = 1;
@@ -994,7 +1004,8 @@ bad:
 		/* a fresh run: forget a previous one here */
 		unlink(wpath(&r, "progress.txt"));
 		unlink(wpath(&r, "accum.exr"));
-		if (write_text_atomic(wpath(&r, "run.txt"), ident, err, sizeof err))
+		if (write_text_atomic(wpath(&r, "run.txt"), ident, err, sizeof err) ||
+		    pov_safe_dir(r.workdir, r.povdir, sizeof r.povdir, err, sizeof err))
 			goto fail;
 		int brc = base_pass(&r, err, sizeof err);
 		if (brc && !r.user_workdir && !r.keep)
@@ -1007,6 +1018,9 @@ bad:
 		    save_progress(&r, err, sizeof err))
 			goto fail;
 	}
+
+	if (pov_safe_dir(r.workdir, r.povdir, sizeof r.povdir, err, sizeof err))
+		goto fail;
 
 	/* refinement passes */
 	int pass = first_pass;
@@ -1079,8 +1093,11 @@ bad:
 			"%.1f s, %.1f CPU s; %s (%ld of %d pixels from the fit)\n", r.stop,
 			r.npasses - 1, est, elapsed(&r), cpu, r.out, took, r.w * r.h);
 	}
-	if (!r.keep && !r.user_workdir)
+	if (!r.keep && !r.user_workdir) {
 		remove_workdir(r.workdir);
+		if (strcmp(r.povdir, r.workdir))
+			unlink(r.povdir);	/* the link pov_safe_dir() made */
+	}
 	ret = 0;
 	goto done;
 

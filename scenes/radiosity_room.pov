@@ -9,7 +9,15 @@
 //   RadCount       radiosity rays per sample (default 35; 400+ for a reference)
 //   RadErrorBound  radiosity error bound (default 1.8; 0.3 for a reference)
 //   RadBounces     recursion limit (default 1)
+//
+// povpress declares POVPRESS_PASS: 0 on the base pass, which saves the
+// radiosity samples (+RFO), and the pass number on region renders, which
+// load them (+RFI).  A region render then skips the pretrace (start = end
+// = 1 pixel) and computes almost no new samples, so its shading is the
+// base pass's, whatever the region's bounds and resolution.
 #version 3.7;
+
+#ifndef (POVPRESS_PASS) #declare POVPRESS_PASS = 0; #end
 
 #ifndef (RadCount)      #declare RadCount = 35;       #end
 #ifndef (RadErrorBound) #declare RadErrorBound = 1.8; #end
@@ -18,8 +26,13 @@
 global_settings {
   assumed_gamma 1.0
   radiosity {
-    pretrace_start 0.08
-    pretrace_end 0.02
+    #if (POVPRESS_PASS > 0)
+      pretrace_start 1
+      pretrace_end 1
+    #else
+      pretrace_start 0.08
+      pretrace_end 0.02
+    #end
     count RadCount
     error_bound RadErrorBound
     recursion_limit RadBounces
