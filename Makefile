@@ -1,5 +1,6 @@
 # povpress build.  `make` builds build/povpress; `make check` runs the unit
-# and end-to-end tests; `make bench` measures analysis throughput; `make sweep`
+# and end-to-end tests (tests/e2e.sh, tests/render.sh); `make demo` renders a
+# bundled scene with `povpress render`; `make bench` measures analysis throughput; `make sweep`
 # measures POV-Ray's own CPU time against error on the bundled scenes
 # (SWEEP_ARGS="--quick scenes/media.pov" passes options to scripts/sweep.sh).
 
@@ -22,7 +23,7 @@ UNIT_SRC = $(wildcard tests/test_*.c)
 UNIT_BIN = $(UNIT_SRC:tests/%.c=$(BUILD)/tests/%)
 TOOL_BIN = $(BUILD)/tests/gen_image $(BUILD)/bench/bench_analyze
 
-.PHONY: all check unit e2e bench clean deps demo sweep
+.PHONY: all check unit e2e bench clean deps demo sweep sampler
 .SECONDARY:
 all: $(BUILD)/povpress
 
@@ -60,8 +61,9 @@ deps: $(BUILD)/.deps
 unit: $(UNIT_BIN)
 	@set -e; for t in $(UNIT_BIN); do echo "== $$t"; $$t; done
 
-e2e: $(BUILD)/povpress $(BUILD)/tests/gen_image
+e2e: $(BUILD)/povpress $(BUILD)/tests/gen_image $(BUILD)/tools/boxdown
 	tests/e2e.sh $(BUILD)
+	tests/render.sh $(BUILD)
 
 check: unit e2e
 
@@ -73,6 +75,10 @@ demo: $(BUILD)/povpress
 
 sweep: $(BUILD)/povpress $(BUILD)/tools/boxdown
 	BUILD=$(BUILD) scripts/sweep.sh $(SWEEP_ARGS)
+
+# How a region gets more samples: +AM2 against resolution scaling, measured.
+sampler: $(BUILD)/povpress $(BUILD)/tools/boxdown
+	scripts/sampler.sh $(BUILD)
 
 clean:
 	rm -rf $(BUILD)

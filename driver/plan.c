@@ -445,6 +445,9 @@ int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *ou
 {
 	fprintf(f, "# povpress regions: pass x0 y0 x1 y1 scale output (pixels 0-based, "
 		"inclusive)\n");
+	for (size_t k = 0; k < pl->nregions; k++)
+		if (strchr(outputs[k], '\n'))
+			return -1;	/* the format is one region per line */
 	for (size_t k = 0; k < pl->nregions; k++) {
 		const struct plan_region *r = &pl->regions[k];
 		fprintf(f, "%d\t%d\t%d\t%d\t%d\t%d\t%s\n", pass, r->x0, r->y0, r->x1, r->y1,
@@ -478,8 +481,9 @@ int plan_regions_read(const char *path, struct plan_region **regions, char ***ou
 			continue;
 		struct plan_region r = {0};
 		int pass, off = 0;
-		if (sscanf(line, "%d\t%d\t%d\t%d\t%d\t%d\t%n", &pass, &r.x0, &r.y0, &r.x1, &r.y1,
-			   &r.scale, &off) != 6 || !off || !line[off]) {
+		/* the output is everything after the sixth tab, spaces and all */
+		if (sscanf(line, "%d\t%d\t%d\t%d\t%d\t%d%n", &pass, &r.x0, &r.y0, &r.x1, &r.y1,
+			   &r.scale, &off) != 6 || !off || line[off] != '\t' || !line[++off]) {
 			errbuf_printf(err, errlen, "'%s' line %d: expected \"pass x0 y0 x1 y1 scale "
 				      "output\" separated by tabs", path, lineno);
 			goto fail;

@@ -99,7 +99,8 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 
 /*
  * The regions file: a header line, then per region a tab-separated line
- * "pass x0 y0 x1 y1 scale output".  plan_regions_read() fills *regions (you
+ * "pass x0 y0 x1 y1 scale output" (the output may hold any byte but a
+ * newline; writing fails on one).  plan_regions_read() fills *regions (you
  * free() it and *outputs, an array of strings each to free()).
  */
 int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *outputs);

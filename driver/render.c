@@ -273,7 +273,7 @@ static int save_progress(struct run *r, char *err, size_t errlen)
 		errbuf_printf(err, errlen, "out of memory");
 		return -1;
 	}
-	int n = snprintf(s, cap, "model %.9g %.9g %.9g %d\n", r->cost_job, r->cost_sample,
+	int n = snprintf(s, cap, "model %.17g %.17g %.17g %d\n", r->cost_job, r->cost_sample,
 			 r->latency, r->radiosity);
 	for (size_t k = 0; k < r->npasses; k++) {
 		const struct pass_rec *p = &r->passes[k];
@@ -478,7 +478,7 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 		r->target);
 	fprintf(f, "  \"budget\": %.6g,\n  \"stop\": ", r->budget);
 	json_str(f, r->stop ? r->stop : "");
-	fprintf(f, ",\n  \"cost_model\": {\"job_s\": %.6g, \"sample_s\": %.6g, "
+	fprintf(f, ",\n  \"cost_model\": {\"job_s\": %.17g, \"sample_s\": %.17g, "
 		"\"latency_s\": %.6g},\n  \"passes\": [\n", r->cost_job, r->cost_sample,
 		r->latency);
 	for (size_t k = 0; k < r->npasses; k++) {
@@ -512,6 +512,12 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 		return -1;
 	}
 	return 0;
+}
+
+/* x rounded to the nearest anchor * 2^k (geometrically). */
+static double quantise(double x, double anchor)
+{
+	return anchor * exp2(round(log2(x / anchor)));
 }
 
 /* The base pass: the whole image, one sample per pixel. */
@@ -579,10 +585,17 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	if (r->latency < 0.0)
 		r->latency = 0.0;
 	r->radiosity = (st->have & POV_HAVE_RADIOSITY) != 0;
+	/* The plan depends on these only through their sizes, and timing noise
+	 * must not change it from run to run (--jobs 1 -- +WT1 is meant to be
+	 * reproducible): the per-sample and setup costs are rounded to powers
+	 * of two, the latency to 0.7 s times a power of two (it measures 0.65
+	 * to 0.75 s here, well inside one step). */
+	r->cost_sample = quantise(r->cost_sample, 1.0);
+	double lat = quantise(r->latency > 0.01 ? r->latency : 0.01, 0.7);
 	/* a region render repeats the setup (parse, bounding) and waits on
 	 * POV-Ray's latency in one of the pool's slots: in core-seconds that
 	 * is the latency times cores over slots */
-	r->cost_job = (setup > 0.0 ? setup : 0.0) + r->latency * r->cores / r->jobs;
+	r->cost_job = (setup > 1e-3 ? quantise(setup, 1.0) : 0.0) + lat * r->cores / r->jobs;
 	if (r->timeout <= 0.0)
 		r->timeout = 60.0 + 20.0 * res.wall_s;
 	struct pass_rec p = {0};
@@ -1090,8 +1103,11 @@ bad:
 		for (size_t k = 0; k < r.npasses; k++)
 			cpu += r.passes[k].cpu_s + r.passes[k].driver_cpu_s;
 		fprintf(stderr, "povpress render: %s after %zu passes: estimated relMSE %.3g, "
-			"%.1f s, %.1f CPU s; %s (%ld of %d pixels from the fit)\n", r.stop,
-			r.npasses - 1, est, elapsed(&r), cpu, r.out, took, r.w * r.h);
+			"%.1f s, %.1f CPU s; wrote %s", r.stop, r.npasses - 1, est, elapsed(&r), cpu,
+			r.out);
+		if (r.final == ACC_FINAL_AUTO)
+			fprintf(stderr, " (%ld of %d pixels from the fit)", took, r.w * r.h);
+		fputc('\n', stderr);
 	}
 	if (!r.keep && !r.user_workdir) {
 		remove_workdir(r.workdir);

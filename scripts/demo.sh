@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
-# Render a bundled scene at low quality through POV-Ray, analyse it with
-# povpress, and compare both the render and its reconstruction with a
-# high-quality render of the same scene.
+# The main job on a bundled scene: `povpress render` renders it adaptively
+# through POV-Ray, then the result, the base pass and the error estimate are
+# compared with a high-quality render of the same scene.
 #
-# usage: scripts/demo.sh [BUILD_DIR] [SCENE.pov] [WIDTH HEIGHT]
-# Writes everything to BUILD_DIR/demo/ (or $DEMO_OUT): base.exr (the render), analysis.exr,
-# ref.exr (the reference), and PNG previews of the render, the
-# reconstruction, the error maps (without and with the +Q1 feature pass)
-# and the order map.
+# usage: scripts/demo.sh [BUILD_DIR] [SCENE.pov] [WIDTH HEIGHT] [TARGET]
+# Writes everything to BUILD_DIR/demo/ (or $DEMO_OUT): render.exr (the
+# result), render.errors.exr (the error map), render.json (the report),
+# work/ (the base pass and the accumulation), ref.exr (the reference), and
+# PNG previews: render.png, base.png, samples.png (samples per pixel) and
+# error.png (estimated error).
 set -euo pipefail
 
 BUILD=${1:-build}
@@ -15,44 +16,45 @@ ROOT=$(cd "$(dirname "$0")/.." && pwd)
 SCENE=${2:-$ROOT/scenes/soft_shadows.pov}
 W=${3:-320}
 H=${4:-240}
+TARGET=${5:-1e-3}
 OUT="${DEMO_OUT:-$BUILD/demo}"
+PP="$BUILD/povpress"
 mkdir -p "$OUT"
 
-render() { # OUTPUT [POV-Ray options...]
-	local o=$1
-	shift
-	povray -D -GA +WT1 "+W$W" "+H$H" +FE "+O$o" "+I$SCENE" "+L$(dirname "$SCENE")" "$@" \
-		>"$o.log" 2>&1 || { cat "$o.log" >&2; exit 1; }
-}
+echo "povpress render $SCENE at ${W}x$H, target relMSE $TARGET"
+"$PP" render "$SCENE" -o "$OUT/render.exr" -W "$W" -H "$H" --target "$TARGET" -v \
+	--report "$OUT/render.json" --workdir "$OUT/work" --keep-workdir
 
-echo "rendering $SCENE at ${W}x$H (low quality)"
-render "$OUT/base.exr"
-echo "rendering the reference (area light 16x16, antialiasing +AM2 +A0.01 +R3)"
-render "$OUT/ref.exr" Declare=AreaN=16 +AM2 +A0.01 +R3 +J
-echo "rendering the +Q1 feature pass (quick colours: noise-free texture and geometry)"
-render "$OUT/features.exr" +Q1
-echo "analysing, without and with features"
-"$BUILD/povpress" analyze "$OUT/base.exr" -o "$OUT/analysis.exr" -v
-"$BUILD/povpress" analyze "$OUT/base.exr" --features "$OUT/features.exr" \
-	-o "$OUT/analysis-features.exr" -v
-
+# The reference: POV-Ray's own antialiasing, a 16x16 area light where the
+# scene has an AreaN knob, 4 threads' worth of time at most a few seconds.
 echo
-echo "render against the reference, and how well each error map predicts its error:"
-"$BUILD/povpress" compare "$OUT/base.exr" "$OUT/ref.exr" --analysis "$OUT/analysis.exr" |
-	sed 's/^/  /'
-"$BUILD/povpress" compare "$OUT/base.exr" "$OUT/ref.exr" --analysis "$OUT/analysis-features.exr" |
-	sed -n 's/^\(est_relmse\|capture20\):/  with features, \1:/p'
-echo "reconstruction against the reference (without, with features):"
-"$BUILD/povpress" compare "$OUT/analysis.exr" "$OUT/ref.exr" | sed 's/^/  /'
-"$BUILD/povpress" compare "$OUT/analysis-features.exr" "$OUT/ref.exr" | sed 's/^/  /'
+echo "rendering the reference (+AM2 +A0.01 +R3 +J, Declare=AreaN=16)"
+povray -D -GA "+W$W" "+H$H" +FE "+O$OUT/ref.exr" "+I$SCENE" "+L$(dirname "$SCENE")" \
+	Declare=AreaN=16 +AM2 +A0.01 +R3 +J >"$OUT/ref.log" 2>&1 || { cat "$OUT/ref.log" >&2; exit 1; }
 
-oiiotool "$OUT/base.exr" --colorconvert linear sRGB -o "$OUT/base.png"
-oiiotool "$OUT/analysis.exr" --ch R,G,B --colorconvert linear sRGB -o "$OUT/reconstruction.png"
-# error map: sqrt(error) scaled so that an RMS error of 0.1 is white
-oiiotool "$OUT/analysis.exr" --ch error --powc 0.5 --mulc 10 --clamp:min=0:max=1 \
+val() { awk -v k="$2:" '$1 == k { print $2 }' <<<"$1"; }
+jget() { grep -o "\"$2\": [-0-9.e+]*" "$1" | tail -n 1 | awk '{ print $2 }'; }
+final=$("$PP" compare "$OUT/render.exr" "$OUT/ref.exr")
+base=$("$PP" compare "$OUT/work/base.exr" "$OUT/ref.exr")
+echo
+echo "against the reference:"
+printf '  base pass (1 sample per pixel)   relMSE %-10s PSNR %s dB\n' \
+	"$(val "$base" relmse)" "$(val "$base" psnr)"
+printf '  povpress render                  relMSE %-10s PSNR %s dB\n' \
+	"$(val "$final" relmse)" "$(val "$final" psnr)"
+printf '  its own estimate of that relMSE  %s\n' "$(jget "$OUT/render.json" est_relmse)"
+printf '  cost: %s CPU s (POV-Ray %s, povpress %s), %s s wall, %s samples per pixel\n' \
+	"$(jget "$OUT/render.json" all_cpu_s)" "$(jget "$OUT/render.json" cpu_s)" \
+	"$(jget "$OUT/render.json" driver_cpu_s)" "$(jget "$OUT/render.json" wall_s)" \
+	"$(jget "$OUT/render.json" samples_per_pixel)"
+
+oiiotool "$OUT/render.exr" --colorconvert linear sRGB -o "$OUT/render.png"
+oiiotool "$OUT/work/base.exr" --colorconvert linear sRGB -o "$OUT/base.png"
+# samples per pixel on a log scale: 1 black, 341 white
+oiiotool "$OUT/render.errors.exr" --ch samples --powc 0.171 --subc 1 --divc 1.71 \
+	--clamp:min=0:max=1 --ch 0,0,0 -o "$OUT/samples.png"
+# estimated relative error: sqrt scaled so that 0.1 is white
+oiiotool "$OUT/render.errors.exr" --ch relerror --powc 0.5 --mulc 3.16 --clamp:min=0:max=1 \
 	--ch 0,0,0 -o "$OUT/error.png"
-oiiotool "$OUT/analysis-features.exr" --ch error --powc 0.5 --mulc 10 --clamp:min=0:max=1 \
-	--ch 0,0,0 -o "$OUT/error-features.png"
-oiiotool "$OUT/analysis.exr" --ch order --mulc 0.5 --ch 0,0,0 -o "$OUT/order.png"
 echo
-echo "previews in $OUT: base.png reconstruction.png error.png error-features.png order.png"
+echo "previews in $OUT: render.png base.png samples.png error.png"

@@ -1,0 +1,278 @@
+#!/usr/bin/env bash
+# End-to-end tests of `povpress render`, `plan` and `merge` through POV-Ray
+# on the bundled scenes, at small sizes: errors and faults, the loop's
+# accuracy against cached high-sample references, determinism, the plan ->
+# xargs -> merge route, interruption and --resume, and awkward paths.
+#
+# usage: tests/render.sh BUILD_DIR
+#
+# References (resolution scale 12: 144 samples per pixel, antialiasing off,
+# box-averaged) are rendered once and cached in
+# ${POVPRESS_CACHE:-$HOME/.cache/povpress}/testref, keyed by the scene's
+# contents, the size and POV-Ray's version.
+set -u
+
+BUILD=${1:-build}
+PP="$(cd "$BUILD" && pwd)/povpress"
+BOXDOWN="$(cd "$BUILD" && pwd)/tools/boxdown"
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+SC="$ROOT/scenes"
+T=$(mktemp -d "${TMPDIR:-/tmp}/povpress-render.XXXXXX")
+CACHE=${POVPRESS_CACHE:-$HOME/.cache/povpress}/testref
+trap 'rm -rf "$T"' EXIT
+W=80
+H=60
+
+passed=0
+failed=0
+ok() { passed=$((passed + 1)); echo "ok   - $1"; }
+bad() { failed=$((failed + 1)); echo "FAIL - $1"; }
+check() { # check DESCRIPTION COMMAND...
+	local d=$1
+	shift
+	if "$@"; then ok "$d"; else bad "$d"; fi
+}
+num() { # num 'EXPR' a b c: true when awk says so
+	awk -v a="${2:-0}" -v b="${3:-0}" -v c="${4:-0}" "BEGIN { exit !($1) }"
+}
+relmse() { # relmse IMAGE REF
+	"$PP" compare "$1" "$2" | awk '$1 == "relmse:" { print $2 }'
+}
+jget() { # jget REPORT KEY: the last value of "KEY": in a JSON report
+	grep -o "\"$2\": [-0-9.e+a-z]*" "$1" | tail -n 1 | awk '{ print $2 }'
+}
+valid_exr() { # a complete, readable EXR with R, G, B
+	oiiotool "$1" --ch R,G,B --printstats >/dev/null 2>&1
+}
+no_povray_left() { # no povray process whose command line mentions $1
+	! pgrep -f -- "$1" >/dev/null 2>&1 || { sleep 2; ! pgrep -f -- "$1" >/dev/null 2>&1; }
+}
+
+POV_VERSION=$(povray --version 2>&1 | head -n 1)
+reference() { # reference SCENE: print the cached reference's path, rendering it if need be
+	local scene=$1 s=12 key dest tmp
+	key=$({
+		echo "povpress test reference 1 ${W}x$H s$s"
+		echo "$POV_VERSION"
+		sha256sum <"$scene"
+	} | sha256sum | cut -c1-16)
+	dest="$CACHE/$(basename "$scene" .pov)-${W}x$H-s$s-$key.exr"
+	if [[ ! -f $dest ]]; then
+		mkdir -p "$CACHE" || return 1
+		tmp=$(mktemp -d "$T/ref.XXXXXX")
+		povray -D -GA +FE -A +W$((s * W)) +H$((s * H)) "+I\"$scene\"" \
+			"+L\"$(dirname "$scene")\"" "+O\"$tmp/hi.exr\"" 2>"$tmp/log" ||
+			{ tail -5 "$tmp/log" >&2; return 1; }
+		"$BOXDOWN" "$tmp/hi.exr" "$s" "$tmp/ref.exr" >/dev/null || return 1
+		mv "$tmp/ref.exr" "$dest"
+		rm -rf "$tmp"
+	fi
+	echo "$dest"
+}
+
+# uniform SCENE CPU REF: the relMSE of the finest uniform resolution-scaled
+# render (antialiasing off, one thread) that costs at most CPU seconds,
+# printed as "SCALE CPU RELMSE"; scale 1 if even that costs more.  Scales
+# up to 10 (12 would be the reference itself).
+uniform() {
+	local scene=$1 budget=$2 ref=$3 s best="" t
+	for s in 1 2 3 4 5 6 7 8 9 10; do
+		local TIMEFORMAT='%3U %3S'
+		t=$({ time povray -D -GA +FE -A +WT1 +W$((s * W)) +H$((s * H)) "+I\"$scene\"" \
+			"+L\"$(dirname "$scene")\"" "+O\"$T/u.exr\"" 2>/dev/null; } 2>&1 |
+			awk '{ print $1 + $2 }')
+		if ((s > 1)) && num 'a > b' "$t" "$budget"; then
+			break
+		fi
+		"$BOXDOWN" "$T/u.exr" "$s" "$T/ud.exr" >/dev/null
+		best="$s $t $(relmse "$T/ud.exr" "$ref")"
+	done
+	echo "$best"
+}
+
+echo "# povpress render tests in $T"
+
+# --- usage -------------------------------------------------------------------
+for c in render plan merge; do
+	check "$c --help exits 0" "$PP" $c --help >/dev/null
+done
+"$PP" render 2>/dev/null
+check "render without a scene is a usage error (2)" test $? -eq 2
+"$PP" render "$SC/smooth_empty.pov" -o "$T/x.exr" --target nope 2>/dev/null
+check "render with a bad --target is a usage error (2)" test $? -eq 2
+
+# --- bad input: a clear message, non-zero, no output --------------------------
+fault() { # fault DESCRIPTION PATTERN OUTPUT COMMAND...: fails, says PATTERN, no OUTPUT
+	local d=$1 pat=$2 out=$3 rc
+	shift 3
+	"$@" >"$T/f.out" 2>"$T/f.err"
+	rc=$?
+	if ((rc != 0)) && grep -q -- "$pat" "$T/f.err" && [[ ! -e $out ]]; then
+		ok "$d"
+	else
+		bad "$d (exit $rc, stderr: $(head -c 300 "$T/f.err"))"
+	fi
+}
+fault "missing scene: named, exit != 0, no output" "cannot read scene '$T/none.pov'" "$T/o.exr" \
+	"$PP" render "$T/none.pov" -o "$T/o.exr" -W 32 -H 24
+printf 'camera { location <0, 1, -3> look_at 0 }\nlight_source { <2, 4, -3> rgb 1 }\n\nsphere { 0, 1 pigment { rgb 1 }\nbox { 0 }\n' >"$T/syntax.pov"
+fault "syntax error: POV-Ray's file and line, no output" "syntax.pov' line 5" "$T/o.exr" \
+	"$PP" render "$T/syntax.pov" -o "$T/o.exr" -W 32 -H 24
+[[ ! -e "$T/o.exr.work" ]]
+check "syntax error: no work directory left behind" test $? -eq 0
+fault "missing povray binary: named, no output" "cannot run '/nonexistent/povray'" "$T/o.exr" \
+	env POVPRESS_POVRAY=/nonexistent/povray "$PP" render "$SC/smooth_empty.pov" -o "$T/o.exr" -W 32 -H 24
+fault "output in a missing directory: named, no output" "cannot write output '$T/no/o.exr'" \
+	"$T/no/o.exr" "$PP" render "$SC/smooth_empty.pov" -o "$T/no/o.exr" -W 32 -H 24
+mkdir -p "$T/ro" && chmod 555 "$T/ro"
+if [[ $(id -u) != 0 ]]; then
+	fault "unwritable output directory: named, no output" "cannot write output" "$T/ro/o.exr" \
+		"$PP" render "$SC/smooth_empty.pov" -o "$T/ro/o.exr" -W 32 -H 24
+fi
+fault "output path that is a directory: named" "is a directory" "$T/ro/none" \
+	"$PP" render "$SC/smooth_empty.pov" -o "$T/ro" -W 32 -H 24
+
+# --- the loop on bundled scenes: better than the base pass and than a
+# uniform render of the same CPU cost ---------------------------------------
+for name in ${RENDER_TEST_SCENES:-soft_shadows glossy_reflection}; do
+	scene="$SC/$name.pov"
+	ref=$(reference "$scene") || { bad "$name: reference render failed"; continue; }
+	"$PP" render "$scene" -o "$T/$name.exr" -W $W -H $H --target 1e-3 -q \
+		--report "$T/$name.json" --workdir "$T/$name.work" --keep-workdir
+	if (($? != 0)); then
+		bad "$name: render failed"
+		continue
+	fi
+	final=$(relmse "$T/$name.exr" "$ref")
+	base=$(relmse "$T/$name.work/base.exr" "$ref")
+	cpu=$(jget "$T/$name.json" all_cpu_s)
+	est=$(jget "$T/$name.json" est_relmse)
+	read -r us ucpu urel <<<"$(uniform "$scene" "$cpu" "$ref")"
+	echo "# $name: base $base, final $final (estimated $est) in $cpu CPU s;" \
+		"uniform scale $us ($ucpu CPU s) $urel"
+	check "$name: final relMSE below the base pass's" num 'a < b' "$final" "$base"
+	check "$name: final relMSE below a uniform render of the same CPU cost" \
+		num 'a < b' "$final" "$urel"
+	check "$name: report has a pass list and totals" \
+		grep -q '"passes": \[' "$T/$name.json"
+	check "$name: error map has error, samples, order and pass channels" \
+		oiiotool "$T/$name.errors.exr" --ch error,samples,order,pass -o "$T/em.exr"
+done
+
+# --- a smooth, nearly empty scene costs almost nothing beyond the base pass --
+"$PP" render "$SC/smooth_empty.pov" -o "$T/smooth.exr" -W $W -H $H -q --report "$T/smooth.json"
+px=$(awk '/"pass": [1-9]/ { for (i = 1; i <= NF; i++) if ($i == "\"pixels\":") s += $(i + 1) }
+	END { print s + 0 }' "$T/smooth.json")
+check "smooth scene: at most 2% of the pixels re-rendered ($px)" num 'a <= 0.02 * b' "$px" $((W * H))
+
+# --- determinism: one job, one POV-Ray thread -------------------------------
+for k in 1 2; do
+	"$PP" render "$SC/soft_shadows.pov" -o "$T/det$k.exr" -W 48 -H 36 --jobs 1 -q \
+		--max-passes 2 --target 1e-4 -- +WT1
+done
+check "--jobs 1 with +WT1: bit-identical output run to run" cmp -s "$T/det1.exr" "$T/det2.exr"
+check "--jobs 1 with +WT1: bit-identical error map run to run" \
+	cmp -s "$T/det1.errors.exr" "$T/det2.errors.exr"
+
+# --- plan, the job list by xargs -P 2, merge == one pass of render ----------
+scene="$SC/soft_shadows.pov"
+"$PP" render "$scene" -o "$T/one.exr" -W 48 -H 36 --jobs 1 --max-passes 1 --target 1e-4 \
+	--final samples -q --workdir "$T/one.work" --keep-workdir --report "$T/one.json" -- +WT1
+cj=$(jget "$T/one.json" job_s)
+cs=$(jget "$T/one.json" sample_s)
+mkdir -p "$T/farm"
+(
+	cd "$T/farm" &&
+	"$PP" merge --init "$T/one.work/base.exr" -o acc0.exr &&
+	"$PP" analyze acc0.exr -o an0.exr &&
+	"$PP" plan an0.exr --state acc0.exr --scene "$scene" -o jobs --target 1e-4 \
+		--cost-job "$cj" --cost-sample "$cs" -- +WT1 >/dev/null &&
+	xargs -P 2 -d '\n' -n 1 sh -c <jobs/jobs.txt &&
+	"$PP" merge acc0.exr jobs/regions.tsv -o acc1.exr >/dev/null
+) 2>"$T/farm.err"
+check "plan -> xargs -P 2 -> merge runs" test $? -eq 0
+check "plan wrote a mask with samples per pixel" \
+	oiiotool "$T/farm/jobs/mask.exr" --ch samples -o "$T/m.exr"
+check "plan's regions are render's regions" \
+	cmp -s <(cut -f1-6 "$T/farm/jobs/regions.tsv") <(cut -f1-6 "$T/one.work/regions.tsv")
+oiiotool "$T/farm/acc1.exr" --ch R,G,B -o "$T/farm/img1.exr" 2>/dev/null
+check "plan -> xargs -> merge gives render's image, bit for bit" \
+	idiff -fail 0 -failpercent 0 "$T/farm/img1.exr" "$T/one.exr" >/dev/null
+
+# --- a region job that crashes or hangs: retried, reported, image valid -----
+cat >"$T/fakepov" <<'EOF'
+#!/bin/sh
+# POV-Ray, except that region renders crash (FAKE=crash) or hang (FAKE=hang)
+for a in "$@"; do
+	case $a in
+	+SC*)
+		echo x >>"$FAKE_LOG"
+		[ "$FAKE" = hang ] && exec sleep 60
+		kill -SEGV $$
+		;;
+	esac
+done
+exec povray "$@"
+EOF
+chmod +x "$T/fakepov"
+for mode in crash hang; do
+	: >"$T/fake.log"
+	FAKE=$mode FAKE_LOG="$T/fake.log" POVPRESS_POVRAY="$T/fakepov" "$PP" render \
+		"$SC/soft_shadows.pov" -o "$T/$mode.exr" -W 48 -H 36 --max-passes 1 --timeout 2 \
+		--report "$T/$mode.json" 2>"$T/$mode.err"
+	rc=$?
+	attempts=$(wc -l <"$T/fake.log")
+	regions=$(awk '/"pass": 1/ { for (i = 1; i <= NF; i++) if ($i == "\"failed\":") print $(i + 1) + 0 }' "$T/$mode.json")
+	check "region job that ${mode}es: exit 0 and a valid image" \
+		test $rc -eq 0 -a -n "$regions"
+	valid_exr "$T/$mode.exr"
+	check "region job that ${mode}es: the image is valid" test $? -eq 0
+	check "region job that ${mode}es: tried twice per region ($attempts runs, $regions failed)" \
+		test "$attempts" -eq $((2 * ${regions:-0})) -a "${regions:-0}" -ge 1
+	check "region job that ${mode}es: reported on stderr" grep -q "$( [ $mode = crash ] && echo crashed || echo 'timed out')" "$T/$mode.err"
+done
+
+# --- SIGINT: children stopped, output absent or valid, --resume finishes ----
+mkdir -p "$T/int"
+"$PP" render "$SC/glossy_reflection.pov" -o "$T/int/out.exr" -W 160 -H 120 --target 1e-5 \
+	--jobs 2 -q --workdir "$T/int/work" --report "$T/int/r.json" &
+pid=$!
+for _ in $(seq 1 100); do	# wait for the first refinement pass to start
+	[[ -f "$T/int/work/regions.tsv" ]] && break
+	sleep 0.1
+done
+sleep 0.5
+kill -INT $pid
+t0=$EPOCHREALTIME
+wait $pid
+rc=$?
+dt=$(awk -v a="$t0" -v b="$EPOCHREALTIME" 'BEGIN { print b - a }')
+check "SIGINT: exits non-zero (130) within 5 s ($dt s)" test $rc -eq 130 -a "${dt%.*}" -lt 5
+check "SIGINT: no POV-Ray child left" no_povray_left "$T/int/work"
+if [[ -e "$T/int/out.exr" ]]; then
+	check "SIGINT: the output is a complete image" valid_exr "$T/int/out.exr"
+else
+	ok "SIGINT: no output (interrupted before one existed)"
+fi
+"$PP" render "$SC/glossy_reflection.pov" -o "$T/int/out.exr" -W 160 -H 120 --target 3e-3 \
+	--jobs 2 -q --workdir "$T/int/work" --resume --report "$T/int/r.json"
+check "--resume finishes the interrupted run" test $? -eq 0
+check "--resume: the output is a complete image" valid_exr "$T/int/out.exr"
+first=$(grep -o '"pass": [0-9]*' "$T/int/r.json" | head -n 1 | awk '{ print $2 }')
+check "--resume: the report keeps the passes before the interruption (from pass $first)" \
+	test "$first" = 0
+"$PP" render "$SC/soft_shadows.pov" -o "$T/int/out.exr" -W 160 -H 120 -q \
+	--workdir "$T/int/work" --resume 2>"$T/int/err"
+check "--resume with another scene is refused" grep -q "another scene" "$T/int/err"
+
+# --- paths with spaces and quotes --------------------------------------------
+D="$T/my \"odd\" dir"
+mkdir -p "$D"
+cp "$SC/radiosity_room.pov" "$D/scene one's.pov"
+"$PP" render "$D/scene one's.pov" -o "$D/out \"1\".exr" -W 48 -H 36 --max-passes 2 -q
+check "scene and output paths with spaces and quotes" test $? -eq 0
+check "... the output exists and is valid" valid_exr "$D/out \"1\".exr"
+check "... and the work directory is gone" test ! -e "$D/out \"1\".exr.work"
+
+echo "# $passed passed, $failed failed"
+((failed == 0))

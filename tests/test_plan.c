@@ -1,0 +1,762 @@
+/*
+ * test_plan.c - unit tests for driver/accum.c (the accumulated render) and
+ * driver/plan.c (the pass planner and its regions file), with the row-band
+ * reader image_read_exr_rows() they rely on.
+ *
+ * Expected statistics are computed here directly, in double, by two passes
+ * over every sample a pixel has; expected planner numbers come from the
+ * model in plan.h and accum.h.  Files go in a fresh mkdtemp() directory.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "driver/accum.h"
+#include "driver/image.h"
+#include "driver/plan.h"
+#include "driver/povray.h"
+#include "tests/testutil.h"
+
+static const char *const rgb_names[] = { "R", "G", "B" };
+static const char *const bgr_names[] = { "B", "G", "R" };
+
+static int setup_dir(void **state)
+{
+	(void)state;
+	snprintf(scratch_dir, sizeof(scratch_dir), "/tmp/povpress-test-plan.XXXXXX");
+	return mkdtemp(scratch_dir) ? 0 : -1;
+}
+
+static int teardown_dir(void **state)
+{
+	(void)state;
+	return run("rm -rf '%s'", scratch_dir) == 0 ? 0 : -1;
+}
+
+static float *accpx(const struct image *acc, size_t i)
+{
+	return acc->px + i * ACC_NCH;
+}
+
+/* Mean and unbiased variance of v[0..n-1], two passes in double. */
+static void stats2(const double *v, int n, double *mean, double *var)
+{
+	double s = 0.0, m2 = 0.0;
+
+	for (int k = 0; k < n; k++)
+		s += v[k];
+	*mean = s / n;
+	for (int k = 0; k < n; k++)
+		m2 += (v[k] - *mean) * (v[k] - *mean);
+	*var = n > 1 ? m2 / (n - 1) : 0.0;
+}
+
+static void assert_close(double got, double want, double rel, double abs_tol, const char *what)
+{
+	if (!(fabs(got - want) <= abs_tol + rel * fabs(want)))
+		fail_msg("%s: got %.9g, want %.9g", what, got, want);
+}
+
+/* An accumulation of w x h pixels whose base render is value(x, y, c). */
+static void make_acc(struct image *acc, int w, int h, double (*value)(int, int, int))
+{
+	struct image base;
+	char err[256];
+
+	assert_int_equal(image_init(&base, w, h, 3, rgb_names, err, sizeof(err)), 0);
+	for (int y = 0; y < h; y++)
+		for (int x = 0; x < w; x++)
+			for (int c = 0; c < 3; c++)
+				base.px[((size_t)y * w + x) * 3 + c] = (float)value(x, y, c);
+	assert_int_equal(accum_from_base(&base, "base", acc, err, sizeof(err)), 0);
+	image_release(&base);
+}
+
+static double base_value(int x, int y, int c)
+{
+	return 0.3 + 0.02 * x + 0.01 * y + 0.05 * c;
+}
+
+static double flat_value(int x, int y, int c)
+{
+	(void)x;
+	(void)y;
+	(void)c;
+	return 0.5;
+}
+
+/* The sub-sample of a render at scale s at render pixel (X, Y). */
+static double sub_value(int X, int Y, int c, int s)
+{
+	return 0.2 + 0.1 * c + 0.01 * ((X * 7 + Y * 13 + c * 5) % 17) + 0.001 * X + 0.003 * s;
+}
+
+/* Rows oy..oy+h-1 of a w-wide render, channels B, G, R. */
+static void make_render(struct image *img, int w, int oy, int h, int s)
+{
+	char err[256];
+
+	assert_int_equal(image_init(img, w, h, 3, bgr_names, err, sizeof(err)), 0);
+	for (int r = 0; r < h; r++)
+		for (int X = 0; X < w; X++)
+			for (int k = 0; k < 3; k++)
+				img->px[((size_t)r * w + X) * 3 + k] =
+					(float)sub_value(X, oy + r, 2 - k, s);
+}
+
+/* The R, G, B (c = 0, 1, 2) of render pixel (X, Y) of img (rows from oy). */
+static float render_at(const struct image *img, int oy, int X, int Y, int c)
+{
+	return img->px[((size_t)(Y - oy) * img->w + X) * 3 + (2 - c)];
+}
+
+/* ------------------------------------------------------------------ */
+
+/* deviations from 1e4: the 5 of base + first set average to a value a
+ * float holds exactly, so only the algorithm is under test */
+static const double base_dev[3] = { 1.0, -0.5, 0.25 };
+
+static double fold_base(int x, int y, int c)
+{
+	return x == 0 && y == 0 ? 1e4 + base_dev[c] : 0.5;
+}
+
+/* 1. accum_fold against a direct two-pass computation over all 21 samples. */
+static void test_fold(void **state)
+{
+	static const double set2[4][3] = {
+		{ -0.5, 0.75, -1.5 }, { 0.25, -1.0, 0.5 }, { 0.75, 0.5, -0.75 },
+		{ -0.25, 0.25, -1.0 },
+	};
+	const double off = 1e4;
+	double all[3][21], mean[3], m2[3];
+	struct image acc;
+	int n = 0;
+
+	(void)state;
+	make_acc(&acc, 2, 1, fold_base);
+	for (int c = 0; c < 3; c++)
+		all[c][0] = off + base_dev[c];
+	n = 1;
+	assert_true(accpx(&acc, 0)[ACC_SAMPLES] == 1.0f);
+	assert_true(accpx(&acc, 0)[ACC_PASS] == 0.0f);
+	assert_true(accpx(&acc, 0)[ACC_VAR_G] == 0.0f);
+	assert_true(accum_has_scale(&acc, 0, 1));
+	assert_int_equal(accum_next_scale(&acc, 0), 2);
+
+	/* 4 samples at scale 2, then 16 at scale 4 */
+	for (int set = 0; set < 2; set++) {
+		int s = set ? 4 : 2, m = s * s;
+		double v[16][3];
+
+		for (int k = 0; k < m; k++)
+			for (int c = 0; c < 3; c++)
+				v[k][c] = off + (set ? 0.0625 * ((k * 7 + c * 3) % 16) - 0.4 + 0.3 * c
+						     : set2[k][c]);
+		for (int c = 0; c < 3; c++) {
+			mean[c] = m2[c] = 0.0;
+			for (int k = 0; k < m; k++)
+				mean[c] += v[k][c] / m;
+			for (int k = 0; k < m; k++)
+				m2[c] += (v[k][c] - mean[c]) * (v[k][c] - mean[c]);
+			for (int k = 0; k < m; k++)
+				all[c][n + k] = v[k][c];
+		}
+		n += m;
+		assert_int_equal(accum_fold(&acc, 0, s, m, mean, m2, 3 + set), 0);
+		assert_true(accpx(&acc, 0)[ACC_SAMPLES] == (float)n);
+		assert_true(accpx(&acc, 0)[ACC_PASS] == (float)(3 + set));
+		assert_true(accum_has_scale(&acc, 0, s));
+		for (int c = 0; c < 3; c++) {
+			double em, ev;
+			char what[64];
+
+			stats2(all[c], n, &em, &ev);
+			snprintf(what, sizeof(what), "n=%d channel %d mean", n, c);
+			/* within a couple of float ulps at 1e4 */
+			assert_close(accpx(&acc, 0)[c], em, 0.0, 2e-3, what);
+			snprintf(what, sizeof(what), "n=%d channel %d variance", n, c);
+			assert_close(accpx(&acc, 0)[ACC_VAR_R + c], ev, 1e-5, 0.0, what);
+		}
+	}
+	assert_int_equal(accum_next_scale(&acc, 0), 8);
+
+	/* scale 2 again: nothing changes */
+	float before[ACC_NCH];
+	memcpy(before, accpx(&acc, 0), sizeof(before));
+	assert_int_equal(accum_fold(&acc, 0, 2, 4, mean, m2, 9), 1);
+	assert_memory_equal(before, accpx(&acc, 0), sizeof(before));
+
+	/* pixel 1 walks through every scale */
+	double c0[3] = { 0.5, 0.5, 0.5 }, z[3] = { 0.0, 0.0, 0.0 };
+	for (int k = 1; k < ACC_NSCALES; k++) {
+		int s = accum_scales[k];
+
+		assert_int_equal(accum_next_scale(&acc, 1), s);
+		assert_false(accum_has_scale(&acc, 1, s));
+		assert_int_equal(accum_fold(&acc, 1, s, s * s, c0, z, k), 0);
+		assert_true(accum_has_scale(&acc, 1, s));
+	}
+	assert_int_equal(accum_next_scale(&acc, 1), 0);
+	assert_true(accpx(&acc, 1)[ACC_SAMPLES] == 1.0f + 4 + 16 + 64 + 256);
+	assert_true(accpx(&acc, 1)[ACC_PASS] == (float)(ACC_NSCALES - 1));
+	image_release(&acc);
+}
+
+/* What pixel (x, y) of make_acc(base_value) should hold after the renders
+ * r2 (scale 2, rows from oy2, rectangle a2) and r4 (scale 4, from oy4, a4). */
+static int expected_pixel(int x, int y, const struct image *r2, int oy2, const int a2[4],
+			  const struct image *r4, int oy4, const int a4[4], double mean[3],
+			  double var[3])
+{
+	double v[3][1 + 4 + 16];
+	int n = 0;
+
+	for (int c = 0; c < 3; c++)
+		v[c][0] = (float)base_value(x, y, c);
+	n = 1;
+	for (int pass = 0; pass < 2; pass++) {
+		const struct image *r = pass ? r4 : r2;
+		const int *a = pass ? a4 : a2;
+		int s = pass ? 4 : 2, oy = pass ? oy4 : oy2;
+
+		if (!r || x < a[0] || x > a[2] || y < a[1] || y > a[3])
+			continue;
+		for (int j = 0; j < s; j++)
+			for (int k = 0; k < s; k++, n++)
+				for (int c = 0; c < 3; c++)
+					v[c][n] = render_at(r, oy, x * s + k, y * s + j, c);
+	}
+	for (int c = 0; c < 3; c++)
+		stats2(v[c], n, &mean[c], &var[c]);
+	return n;
+}
+
+/* 2. accum_merge_region: block statistics, untouched outside, errors. */
+static void test_merge_region(void **state)
+{
+	const int W = 10, H = 20;
+	const int a2[4] = { 3, 10, 7, 13 }, a4[4] = { 5, 12, 9, 15 };	/* x0 y0 x1 y1 */
+	const int oy2 = 2 * a2[1] - 16, oy4 = 4 * a4[1] - 16;
+	struct image acc, r2, r4, bad;
+	size_t npx = (size_t)W * H, bytes = npx * ACC_NCH * sizeof(float);
+	char err[256];
+	long folded = -1;
+
+	(void)state;
+	make_acc(&acc, W, H, base_value);
+	float *orig = malloc(bytes), *snap = malloc(bytes);
+	assert_non_null(orig);
+	assert_non_null(snap);
+	memcpy(orig, acc.px, bytes);
+
+	make_render(&r2, 2 * W, oy2, 2 * (a2[3] + 1) - oy2 + 3, 2);
+	make_render(&r4, 4 * W, oy4, 4 * (a4[3] + 1) - oy4 + 5, 4);
+	assert_int_equal(accum_merge_region(&acc, &r2, oy2, 2, a2[0], a2[1], a2[2], a2[3], 1,
+					    &folded, err, sizeof(err)), 0);
+	assert_int_equal(folded, 5 * 4);
+	assert_int_equal(accum_merge_region(&acc, &r4, oy4, 4, a4[0], a4[1], a4[2], a4[3], 2,
+					    &folded, err, sizeof(err)), 0);
+	assert_int_equal(folded, 5 * 4);
+
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++) {
+			size_t i = (size_t)y * W + x;
+			int in2 = x >= a2[0] && x <= a2[2] && y >= a2[1] && y <= a2[3];
+			int in4 = x >= a4[0] && x <= a4[2] && y >= a4[1] && y <= a4[3];
+			const float *o = accpx(&acc, i);
+			double em[3], ev[3];
+			char what[64];
+
+			if (!in2 && !in4) {
+				assert_memory_equal(o, orig + i * ACC_NCH, ACC_NCH * sizeof(float));
+				continue;
+			}
+			int n = expected_pixel(x, y, &r2, oy2, a2, &r4, oy4, a4, em, ev);
+			assert_true(o[ACC_SAMPLES] == (float)n);
+			assert_true(o[ACC_PASS] == (in4 ? 2.0f : 1.0f));
+			assert_true(o[ACC_SCALES] == (float)(2 + (in2 ? 4 : 0) + (in4 ? 16 : 0)));
+			for (int c = 0; c < 3; c++) {
+				snprintf(what, sizeof(what), "(%d,%d) c%d mean", x, y, c);
+				assert_close(o[c], em[c], 1e-6, 0.0, what);
+				snprintf(what, sizeof(what), "(%d,%d) c%d variance", x, y, c);
+				assert_close(o[ACC_VAR_R + c], ev[c], 1e-5, 1e-12, what);
+			}
+		}
+
+	/* scale 2 again over the same pixels: no new samples */
+	memcpy(snap, acc.px, bytes);
+	assert_int_equal(accum_merge_region(&acc, &r2, oy2, 2, a2[0], a2[1], a2[2], a2[3], 5,
+					    &folded, err, sizeof(err)), 0);
+	assert_int_equal(folded, 0);
+	assert_memory_equal(snap, acc.px, bytes);
+
+	/* failures change nothing */
+	make_render(&bad, 2 * W - 2, oy2, r2.h, 2);
+	err[0] = '\0';
+	assert_int_equal(accum_merge_region(&acc, &bad, oy2, 2, 0, 10, 9, 11, 6, &folded, err,
+					    sizeof(err)), -1);
+	assert_true(err[0] != '\0');
+	image_release(&bad);
+	/* the first needed row (20) is not there / the last (31) is not */
+	assert_int_equal(accum_merge_region(&acc, &r2, 21, 2, 0, 10, 9, 11, 6, &folded, err,
+					    sizeof(err)), -1);
+	assert_int_equal(accum_merge_region(&acc, &r2, oy2, 2, 0, 10, 9, 15, 6, &folded, err,
+					    sizeof(err)), -1);
+	/* outside the image */
+	assert_int_equal(accum_merge_region(&acc, &r2, oy2, 2, 0, 10, W, 11, 6, &folded, err,
+					    sizeof(err)), -1);
+	assert_int_equal(accum_merge_region(&acc, &r2, oy2, 2, -1, 10, 3, 11, 6, &folded, err,
+					    sizeof(err)), -1);
+	/* scale 3, with a render of the matching width */
+	make_render(&bad, 3 * W, 0, 3 * H, 3);
+	err[0] = '\0';
+	assert_int_equal(accum_merge_region(&acc, &bad, 0, 3, 0, 0, 1, 1, 6, &folded, err,
+					    sizeof(err)), -1);
+	assert_non_null(strstr(err, "3"));
+	assert_int_equal(folded, 0);
+	image_release(&bad);
+	assert_memory_equal(snap, acc.px, bytes);
+
+	free(orig);
+	free(snap);
+	image_release(&r2);
+	image_release(&r4);
+	image_release(&acc);
+}
+
+/* 3. A non-finite sub-sample is skipped; a block of them adds nothing. */
+static void test_merge_nonfinite(void **state)
+{
+	struct image acc, r;
+	char err[256];
+	long folded = -1;
+	double v[3][4], em, ev;
+	int n = 0;
+
+	(void)state;
+	make_acc(&acc, 4, 4, base_value);
+	make_render(&r, 8, 0, 8, 2);
+	/* pixel (0,0): G of sub-sample (1,0) is NaN; channel index 1 is G */
+	r.px[(0 * 8 + 1) * 3 + 1] = NAN;
+	/* pixel (1,0): every sub-sample has a NaN or an infinity */
+	r.px[(0 * 8 + 2) * 3 + 0] = NAN;
+	r.px[(0 * 8 + 3) * 3 + 2] = INFINITY;
+	r.px[(1 * 8 + 2) * 3 + 1] = -INFINITY;
+	r.px[(1 * 8 + 3) * 3 + 0] = NAN;
+	float before1[ACC_NCH];
+	memcpy(before1, accpx(&acc, 1), sizeof(before1));
+
+	assert_int_equal(accum_merge_region(&acc, &r, 0, 2, 0, 0, 3, 3, 1, &folded, err,
+					    sizeof(err)), 0);
+	assert_int_equal(folded, 15);
+
+	for (int c = 0; c < 3; c++)
+		v[c][0] = (float)base_value(0, 0, c);
+	n = 1;
+	for (int j = 0; j < 2; j++)
+		for (int k = 0; k < 2; k++) {
+			if (j == 0 && k == 1)
+				continue;
+			for (int c = 0; c < 3; c++)
+				v[c][n] = render_at(&r, 0, k, j, c);
+			n++;
+		}
+	assert_true(accpx(&acc, 0)[ACC_SAMPLES] == 4.0f);
+	for (int c = 0; c < 3; c++) {
+		stats2(v[c], n, &em, &ev);
+		assert_close(accpx(&acc, 0)[c], em, 1e-6, 0.0, "mean without the NaN");
+		assert_close(accpx(&acc, 0)[ACC_VAR_R + c], ev, 1e-5, 1e-12,
+			     "variance without the NaN");
+	}
+	/* no finite sub-sample: the pixel keeps its sample, scale 2 is spent */
+	assert_true(accpx(&acc, 1)[ACC_SAMPLES] == 1.0f);
+	for (int c = 0; c < 3; c++) {
+		assert_true(accpx(&acc, 1)[c] == before1[c]);
+		assert_true(isfinite(accpx(&acc, 1)[ACC_VAR_R + c]));
+	}
+	assert_true(accum_has_scale(&acc, 1, 2));
+	image_release(&r);
+	image_release(&acc);
+}
+
+/* 4. accum_read round-trips an accumulation; a missing channel is named. */
+static void test_accum_read(void **state)
+{
+	struct image acc, got = {0}, partial;
+	const char *names[ACC_NCH - 1];
+	char path[256], err[512];
+	double mean[3] = { 0.25, 0.5, 0.75 }, m2[3] = { 0.01, 0.02, 0.03 };
+
+	(void)state;
+	make_acc(&acc, 5, 4, base_value);
+	assert_int_equal(accum_fold(&acc, 3, 2, 4, mean, m2, 1), 0);
+	assert_int_equal(accum_fold(&acc, 3, 4, 16, mean, m2, 2), 0);
+	assert_int_equal(accum_fold(&acc, 17, 2, 3, mean, m2, 1), 0);
+	scratch(path, sizeof(path), "acc.exr");
+	assert_int_equal(image_write_exr(path, &acc, err, sizeof(err)), 0);
+	assert_int_equal(accum_read(path, &got, err, sizeof(err)), 0);
+	assert_int_equal(got.w, 5);
+	assert_int_equal(got.h, 4);
+	assert_int_equal(got.nch, ACC_NCH);
+	for (int c = 0; c < ACC_NCH; c++)
+		assert_string_equal(got.names[c], accum_names[c]);
+	assert_memory_equal(got.px, acc.px, (size_t)5 * 4 * ACC_NCH * sizeof(float));
+	image_release(&got);
+
+	/* every channel but 'samples' */
+	for (int c = 0, k = 0; c < ACC_NCH; c++)
+		if (c != ACC_SAMPLES)
+			names[k++] = accum_names[c];
+	assert_int_equal(image_init(&partial, 5, 4, ACC_NCH - 1, names, err, sizeof(err)), 0);
+	scratch(path, sizeof(path), "partial.exr");
+	assert_int_equal(image_write_exr(path, &partial, err, sizeof(err)), 0);
+	err[0] = '\0';
+	assert_int_equal(accum_read(path, &got, err, sizeof(err)), -1);
+	if (!strstr(err, "'samples'") || !strstr(err, path))
+		fail_msg("message \"%s\" does not name the channel and the file", err);
+	image_release(&partial);
+	image_release(&acc);
+}
+
+/* 5. image_read_exr_rows reads whole 32-row PIZ chunks around the rows. */
+static void test_read_rows(void **state)
+{
+	const int w = 40, h = 100;
+	struct image img, got;
+	char path[256], err[512];
+	int oy = -1;
+	static const int ask[][2] = { { 37, 58 }, { 30, 70 }, { 90, 99 }, { 95, 150 } };
+
+	(void)state;
+	assert_int_equal(image_init(&img, w, h, 3, rgb_names, err, sizeof(err)), 0);
+	for (int y = 0; y < h; y++)
+		for (int x = 0; x < w; x++)
+			for (int c = 0; c < 3; c++)
+				img.px[((size_t)y * w + x) * 3 + c] = (float)(y * 1000 + x + 0.25 * c);
+	scratch(path, sizeof(path), "rows.exr");
+	assert_int_equal(image_write_exr(path, &img, err, sizeof(err)), 0);
+
+	for (size_t t = 0; t < sizeof(ask) / sizeof(ask[0]); t++) {
+		int y0 = ask[t][0], y1 = ask[t][1] < h ? ask[t][1] : h - 1;
+
+		oy = -1;
+		assert_int_equal(image_read_exr_rows(path, ask[t][0], ask[t][1], &got, &oy, err,
+						     sizeof(err)), 0);
+		assert_true(oy >= 0 && oy <= y0);
+		/* from the start of the chunk holding y0, not a whole-file read */
+		assert_int_equal(oy % 32, 0);
+		assert_true(y0 - oy < 32);
+		assert_true(oy + got.h - 1 >= y1);
+		assert_true(oy + got.h <= h);
+		assert_true(got.h < h || y0 < 32);	/* a band, not the file */
+		assert_int_equal(got.w, w);
+		for (int k = 0; k < got.h; k++)
+			for (int x = 0; x < w; x++)
+				for (int c = 0; c < 3; c++) {
+					int gc = image_channel(&got, rgb_names[c]);
+					float g = got.px[((size_t)k * w + x) * got.nch + gc];
+					float e = img.px[((size_t)(oy + k) * w + x) * 3 + c];
+
+					if (g != e)
+						fail_msg("rows %d..%d: row %d x %d c %d: got %g, "
+							 "want %g", y0, y1, oy + k, x, c, g, e);
+				}
+		image_release(&got);
+	}
+
+	/* past the last row */
+	err[0] = '\0';
+	assert_int_equal(image_read_exr_rows(path, 100, 120, &got, &oy, err, sizeof(err)), -1);
+	assert_true(err[0] != '\0');
+	assert_zeroed(&got);
+	image_release(&img);
+}
+
+/* ------------------------------------------------------------------ */
+
+#define PW 64
+#define PH 48
+
+struct plan_input {
+	struct image acc;
+	float press[PW * PH];
+	float fit[PW * PH * 3];
+};
+
+/* A flat 0.5 image; press 0 except err on the listed blocks (x0 y0 x1 y1). */
+static void plan_input(struct plan_input *in, const int (*blocks)[4], int nblocks, float err)
+{
+	make_acc(&in->acc, PW, PH, flat_value);
+	for (int i = 0; i < PW * PH; i++) {
+		in->press[i] = 0.0f;
+		for (int c = 0; c < 3; c++)
+			in->fit[3 * i + c] = accpx(&in->acc, (size_t)i)[c];
+	}
+	for (int b = 0; b < nblocks; b++)
+		for (int y = blocks[b][1]; y <= blocks[b][3]; y++)
+			for (int x = blocks[b][0]; x <= blocks[b][2]; x++)
+				in->press[y * PW + x] = err;
+}
+
+static int in_region(const struct plan_region *r, int x, int y)
+{
+	return x >= r->x0 && x <= r->x1 && y >= r->y0 && y <= r->y1;
+}
+
+/* Regions inside the image, at most max_regions, pixels counts their union. */
+static void check_regions(const struct plan *pl, const struct plan_params *p)
+{
+	long inside = 0;
+
+	assert_true(pl->nregions <= (size_t)p->max_regions);
+	for (size_t k = 0; k < pl->nregions; k++) {
+		const struct plan_region *r = &pl->regions[k];
+
+		assert_true(r->x0 >= 0 && r->x0 <= r->x1 && r->x1 < PW);
+		assert_true(r->y0 >= 0 && r->y0 <= r->y1 && r->y1 < PH);
+		assert_int_equal(r->scale, 2);
+	}
+	for (int y = 0; y < PH; y++)
+		for (int x = 0; x < PW; x++) {
+			int any = 0;
+
+			for (size_t k = 0; k < pl->nregions; k++)
+				any |= in_region(&pl->regions[k], x, y);
+			inside += any;
+			assert_true(pl->scale[y * PW + x] == (any ? 2.0f : 0.0f));
+		}
+	assert_int_equal(pl->pixels, inside);
+	assert_true(pl->samples == 4.0 * (double)inside);
+}
+
+/* 6. plan_make: refine, target met, no budget, packing, no gain. */
+static void test_plan_make(void **state)
+{
+	static const int block[1][4] = { { 20, 17, 25, 21 } };	/* 6 x 5 */
+	static const int two[2][4] = { { 2, 2, 4, 4 }, { 58, 40, 61, 43 } };
+	struct plan_input *in = malloc(sizeof(*in));
+	struct plan_params p;
+	struct plan pl;
+	char err[256];
+
+	(void)state;
+	assert_non_null(in);
+	plan_params_init(&p);
+	plan_input(in, block, 1, 1.0f);
+	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
+	assert_int_equal(pl.outcome, PLAN_REFINE);
+	assert_int_equal(pl.chosen_pixels, 30);
+	for (int y = 0; y < PH; y++)
+		for (int x = 0; x < PW; x++) {
+			int inb = x >= 20 && x <= 25 && y >= 17 && y <= 21, found = 0;
+
+			assert_true(pl.chosen[y * PW + x] == (inb ? 1.0f : 0.0f));
+			for (size_t k = 0; inb && k < pl.nregions; k++)
+				found |= in_region(&pl.regions[k], x, y) && pl.regions[k].scale == 2;
+			assert_true(!inb || (found && pl.scale[y * PW + x] == 2.0f));
+		}
+	check_regions(&pl, &p);
+	/* e = press / (0.5^2 + 0.01) on the block; scale 2 divides it by 5 */
+	double est = 30.0 * (1.0 / 0.26) / (PW * PH);
+	assert_close(pl.est_relmse, est, 1e-6, 0.0, "est_relmse");
+	assert_true(pl.est_after < pl.est_relmse);
+	assert_close(pl.est_after, est / 5.0, 1e-6, 0.0, "est_after");
+	plan_release(&pl);
+	image_release(&in->acc);
+
+	/* nothing to fix */
+	plan_input(in, block, 0, 0.0f);
+	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
+	assert_int_equal(pl.outcome, PLAN_TARGET_MET);
+	assert_int_equal(pl.nregions, 0);
+	plan_release(&pl);
+	image_release(&in->acc);
+
+	/* a budget below one pixel's 4 samples */
+	plan_input(in, block, 1, 1.0f);
+	p.budget = 0.5 * 4 * p.cost_sample;
+	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
+	assert_int_equal(pl.outcome, PLAN_NO_BUDGET);
+	assert_int_equal(pl.nregions, 0);
+	plan_release(&pl);
+	p.budget = 0.0;
+	image_release(&in->acc);
+
+	/* two distant blocks: one render when a job is dear, two when free */
+	plan_input(in, two, 2, 1.0f);
+	p.cost_job = 1e3;
+	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
+	assert_int_equal(pl.outcome, PLAN_REFINE);
+	assert_int_equal(pl.nregions, 1);
+	assert_true(pl.regions[0].x0 <= 2 && pl.regions[0].y0 <= 2 && pl.regions[0].x1 >= 61 &&
+		    pl.regions[0].y1 >= 43);
+	assert_int_equal(pl.chosen_pixels, 9 + 16);
+	check_regions(&pl, &p);
+	plan_release(&pl);
+
+	p.cost_job = 0.0;
+	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
+	assert_int_equal(pl.outcome, PLAN_REFINE);
+	assert_int_equal(pl.nregions, 2);
+	for (int b = 0; b < 2; b++) {
+		int hits = 0;
+
+		for (size_t k = 0; k < 2; k++)
+			hits += in_region(&pl.regions[k], two[b][0], two[b][1]) &&
+				in_region(&pl.regions[k], two[b][2], two[b][3]);
+		assert_int_equal(hits, 1);
+	}
+	assert_false(in_region(&pl.regions[0], 30, 20) || in_region(&pl.regions[1], 30, 20));
+	check_regions(&pl, &p);
+	plan_release(&pl);
+
+	/* ... and a cap of one region forces the merge */
+	p.max_regions = 1;
+	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
+	assert_int_equal(pl.outcome, PLAN_REFINE);
+	assert_int_equal(pl.nregions, 1);
+	check_regions(&pl, &p);
+	assert_int_equal(pl.chosen_pixels, 9 + 16);
+	plan_release(&pl);
+	plan_params_init(&p);
+	image_release(&in->acc);
+
+	/* every scale already sampled everywhere, large error */
+	plan_input(in, block, 0, 0.0f);
+	for (int i = 0; i < PW * PH; i++) {
+		in->press[i] = 1.0f;
+		accpx(&in->acc, (size_t)i)[ACC_SCALES] = 2.0f + 4 + 16 + 256 + 65536;
+	}
+	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
+	assert_true(pl.est_relmse > p.target);
+	assert_int_equal(pl.outcome, PLAN_NO_GAIN);
+	assert_int_equal(pl.nregions, 0);
+	plan_release(&pl);
+	image_release(&in->acc);
+	free(in);
+}
+
+/* 7. The regions file round-trips; a bad line is reported with its number. */
+static void test_regions_file(void **state)
+{
+	struct plan_region rs[3] = {
+		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1 },
+		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2 },
+		{ 63, 47, 63, 47, 16, 1, 0.1, 0.3 },
+	};
+	static char o0[] = "r0.exr", o1[] = "a dir/with spaces/region 1.exr",
+		o2[] = "/tmp/x y  z.exr";
+	char *outs[3] = { o0, o1, o2 };
+	struct plan pl;
+	struct plan_region *got;
+	char **gout, path[256], err[512];
+	int *passes;
+	size_t n = 99;
+	FILE *f;
+
+	(void)state;
+	memset(&pl, 0, sizeof(pl));
+	pl.regions = rs;
+	pl.nregions = 3;
+	scratch(path, sizeof(path), "regions file.txt");
+	f = fopen(path, "w");
+	assert_non_null(f);
+	assert_int_equal(plan_regions_write(f, &pl, 7, outs), 0);
+	assert_int_equal(fclose(f), 0);
+	assert_int_equal(plan_regions_read(path, &got, &gout, &passes, &n, err, sizeof(err)), 0);
+	assert_int_equal(n, 3);
+	for (size_t k = 0; k < 3; k++) {
+		assert_int_equal(passes[k], 7);
+		assert_int_equal(got[k].x0, rs[k].x0);
+		assert_int_equal(got[k].y0, rs[k].y0);
+		assert_int_equal(got[k].x1, rs[k].x1);
+		assert_int_equal(got[k].y1, rs[k].y1);
+		assert_int_equal(got[k].scale, rs[k].scale);
+		assert_string_equal(gout[k], outs[k]);
+		free(gout[k]);
+	}
+	free(got);
+	free(gout);
+	free(passes);
+
+	/* line 3 has a letter for y0; then a line without an output */
+	static const char *const bad[] = {
+		"# header\n1\t0\t0\t3\t3\t2\ta.exr\n1\t0\tx\t3\t3\t2\tb.exr\n",
+		"# header\n\n1\t0\t0\t3\t3\t2\t\n",
+	};
+	for (int b = 0; b < 2; b++) {
+		f = fopen(path, "w");
+		assert_non_null(f);
+		fputs(bad[b], f);
+		assert_int_equal(fclose(f), 0);
+		err[0] = '\0';
+		assert_int_equal(plan_regions_read(path, &got, &gout, &passes, &n, err,
+						   sizeof(err)), -1);
+		if (!strstr(err, path) || !strstr(err, "line 3"))
+			fail_msg("message \"%s\" does not name '%s' line 3", err, path);
+		assert_null(got);
+		assert_null(gout);
+		assert_null(passes);
+	}
+}
+
+/* 8. The POV-Ray job for a region. */
+static void test_plan_job(void **state)
+{
+	static const char *const base_extra[] = { "+Q9", "Antialias_Threshold=0.1" };
+	struct pov_job base, job;
+	struct plan_region r = { 3, 2, 10, 7, 4, 0, 0.0, 0.0 };
+	struct pov_region region;
+	const char *extra[3];
+
+	(void)state;
+	memset(&base, 0, sizeof(base));
+	base.scene = "scenes/x.pov";
+	base.output = "base.exr";
+	base.width = 64;
+	base.height = 48;
+	base.threads = 3;
+	base.extra = base_extra;
+	base.nextra = 2;
+	plan_job(&base, &r, "out/r.exr", &region, extra, &job);
+	assert_int_equal(job.width, 256);
+	assert_int_equal(job.height, 192);
+	assert_ptr_equal(job.region, &region);
+	assert_int_equal(region.x0, 12);
+	assert_int_equal(region.y0, 8);
+	assert_int_equal(region.x1, 43);
+	assert_int_equal(region.y1, 31);
+	assert_string_equal(job.output, "out/r.exr");
+	assert_string_equal(job.scene, "scenes/x.pov");
+	assert_int_equal(job.threads, 3);
+	assert_int_equal(job.nextra, 3);
+	assert_string_equal(job.extra[0], "+Q9");
+	assert_string_equal(job.extra[1], "Antialias_Threshold=0.1");
+	assert_string_equal(job.extra[2], "-A");
+	assert_string_equal(base.output, "base.exr");
+	assert_int_equal(base.nextra, 2);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_fold),
+		cmocka_unit_test(test_merge_region),
+		cmocka_unit_test(test_merge_nonfinite),
+		cmocka_unit_test(test_accum_read),
+		cmocka_unit_test(test_read_rows),
+		cmocka_unit_test(test_plan_make),
+		cmocka_unit_test(test_regions_file),
+		cmocka_unit_test(test_plan_job),
+	};
+
+	return cmocka_run_group_tests(tests, setup_dir, teardown_dir);
+}
