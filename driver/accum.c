@@ -16,7 +16,7 @@
 const int accum_scales[ACC_NSCALES] = { 1, 2, 4, 8, 16 };
 
 const char *const accum_names[ACC_NCH] = {
-	"R", "G", "B", "samples", "var.R", "var.G", "var.B", "pass", "scales",
+	"R", "G", "B", "samples", "var.R", "var.G", "var.B", "pass", "scales", "diff",
 };
 
 static uint32_t scale_mask(const struct image *acc, size_t i)
@@ -59,6 +59,7 @@ int accum_from_base(const struct image *base, const char *what, struct image *ac
 		/* a pixel POV-Ray could not shade counts as no sample */
 		o[ACC_SAMPLES] = ok ? 1.0f : 0.0f;
 		o[ACC_SCALES] = 2.0f;	/* bit 1: scale 1 */
+		o[ACC_DIFF] = NAN;
 	}
 	image_release(&rgb);
 	return 0;
@@ -102,6 +103,7 @@ int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
 	if (n <= 0)
 		return 0;
 	double na = o[ACC_SAMPLES], nb = n, nt = na + nb;
+	double d2 = 0.0;
 	for (int c = 0; c < 3; c++) {
 		double ma = na > 0 ? o[c] : 0.0;
 		double m2a = na > 1 ? (double)o[ACC_VAR_R + c] * (na - 1.0) : 0.0;
@@ -110,7 +112,10 @@ int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
 		double m2t = m2a + m2[c] + d * d * na * nb / nt;
 		o[c] = (float)mt;
 		o[ACC_VAR_R + c] = nt > 1 ? (float)(m2t / (nt - 1.0)) : 0.0f;
+		d2 += d * d / (mt * mt + METRICS_RELMSE_EPS) / 3.0;
 	}
+	if (na > 0)
+		o[ACC_DIFF] = (float)(d2 * na * nb / (nt * nt));
 	o[ACC_SAMPLES] = (float)nt;
 	o[ACC_PASS] = (float)pass;
 	return 0;
@@ -198,10 +203,22 @@ static int finest_scale(const struct image *acc, size_t i)
 	return best;
 }
 
-double accum_contrast(const struct image *acc, size_t i, const float fit[3])
+/*
+ * The expected relative squared error of pixel i from an edge hidden
+ * between its samples and its neighbours': for each neighbour and channel,
+ * the part d of their difference that neither pixel's own samples show
+ * (d^2 less 12 times each one's sample variance, a ramp of height d having
+ * variance d^2 / 12), an edge at an unknown place in the unsampled strip
+ * of width 1/(2s) next to the neighbour moves the pixel's value v by
+ * alpha d, alpha uniform in [0, 1/(2s)]: the mean over alpha of
+ * (alpha d)^2 / ((v + alpha d)^2 + 0.01), by the midpoint rule on 4
+ * points.  The largest over the eight neighbours, mean over R, G, B.
+ */
+static double hidden_edge(const struct image *acc, size_t i, int s)
 {
 	const int w = acc->w, h = acc->h, x = (int)(i % (size_t)w), y = (int)(i / (size_t)w);
 	const float *o = acc->px + i * ACC_NCH;
+	const int own = o[ACC_SAMPLES] >= 4.0f;
 	double best = 0.0;
 	for (int dy = -1; dy <= 1; dy++)
 		for (int dx = -1; dx <= 1; dx++) {
@@ -210,53 +227,43 @@ double accum_contrast(const struct image *acc, size_t i, const float fit[3])
 			const float *q = acc->px + ((size_t)(y + dy) * w + (x + dx)) * ACC_NCH;
 			if (!(q[ACC_SAMPLES] > 0.0f))
 				continue;
-			double d2 = 0.0;
+			const int theirs = q[ACC_SAMPLES] >= 4.0f;
+			double e = 0.0;
 			for (int c = 0; c < 3; c++) {
-				/* relative to the brighter side: what an edge could
-				 * move this pixel by, relative to what it would then be
-				 * (a dark pixel beside a light source must not count
-				 * the light's brightness over its own darkness) */
-				double f = isfinite(fit[c]) ? fabs(fit[c]) : fabs(o[c]);
-				double g = fabs((double)q[c]) > f ? fabs((double)q[c]) : f;
-				double d = (double)q[c] - o[c];
-				d2 += d * d / (g * g + METRICS_RELMSE_EPS) / 3.0;
+				double d = (double)q[c] - o[c], v = o[c];
+				double h2 = d * d - 12.0 * ((own ? o[ACC_VAR_R + c] : 0.0) +
+							    (theirs ? q[ACC_VAR_R + c] : 0.0));
+				if (!(h2 > 0.0))
+					continue;
+				double dh = d > 0.0 ? sqrt(h2) : -sqrt(h2);
+				for (int k = 0; k < 4; k++) {
+					double m = (k + 0.5) / (8.0 * s) * dh;
+					e += m * m / ((v + m) * (v + m) + METRICS_RELMSE_EPS) / 12.0;
+				}
 			}
-			if (d2 > best)
-				best = d2;
+			if (e > best)
+				best = e;
 		}
 	return isfinite(best) ? best : 1.0;
 }
 
 double accum_pixel_error(const struct image *acc, size_t i, double press, const float fit[3],
-			 double contrast)
+			 double diff)
 {
 	const float *o = acc->px + i * ACC_NCH;
-	double den = 0.0, vrel = 0.0;
+	double den = 0.0;
 	for (int c = 0; c < 3; c++) {
 		double f = isfinite(fit[c]) ? fit[c] : o[c];
-		double d = f * f + METRICS_RELMSE_EPS;
-		den += d / 3.0;
-		vrel += o[ACC_VAR_R + c] / d / 3.0;
+		den += (f * f + METRICS_RELMSE_EPS) / 3.0;
 	}
 	/* no estimate (a hole the regression could not reach): assume the worst
 	 * a pixel of this brightness can plausibly be off by */
 	double e = isfinite(press) ? press / den : 1.0;
 	double n = o[ACC_SAMPLES];
-	if (n >= 4.0) {
-		double ev = vrel / n;
-		if (ev < e)
-			e = ev;
-	}
-	/* an edge or a detail between every sample position so far: a grid of
-	 * s x s samples places an edge with an error of up to 1/(2s) of the
-	 * pixel, uniform, so its squared error is contrast^2 / (12 s^2) */
-	int s = finest_scale(acc, i);
-	/* a smooth gradient also differs from its neighbours, by about the
-	 * spread of the pixel's own samples (a linear ramp of height d has
-	 * sample variance d^2 / 12; twice that allows for diagonals): only the
-	 * contrast the samples do not show can hide an edge */
-	double hidden = contrast - (n >= 4.0 ? 24.0 * vrel : 0.0);
-	double edge = hidden > 0.0 ? hidden / (12.0 * s * s) : 0.0;
+	if (n >= 4.0 && isfinite(diff))
+		e = diff;
+	/* an edge or a detail between every sample position so far */
+	double edge = hidden_edge(acc, i, finest_scale(acc, i));
 	if (edge > e)
 		e = edge;
 	if (n <= 0.0)

@@ -12,6 +12,16 @@
  *   pass           the pass that last added samples (0: the base pass)
  *   scales         the resolution scales already sampled, as a bit mask
  *                  (bit s for scale s; the base pass is scale 1)
+ *   diff           the error of the mean measured by its last fold: two
+ *                  independent estimates of the pixel, the samples before
+ *                  (n_a) and the samples added (n_b), differ by d; if each
+ *                  has squared error c / n, E[d^2] = c (1/n_a + 1/n_b), so
+ *                  the mean of all n_a + n_b has squared error about
+ *                  d^2 n_a n_b / (n_a + n_b)^2.  Stored relative (over the
+ *                  value^2 + 0.01, mean over R, G, B); NaN before a fold.
+ *                  Unlike the sample variance it sees how fast the mean
+ *                  really converges (stratified grids, POV-Ray's own
+ *                  low-discrepancy sampling of lenses and lights).
  *
  * Samples are added by resolution scaling: a region rendered at s times the
  * resolution gives every pixel s x s new samples on a regular grid of sub-
@@ -29,7 +39,7 @@
 
 enum {
 	ACC_R, ACC_G, ACC_B, ACC_SAMPLES, ACC_VAR_R, ACC_VAR_G, ACC_VAR_B, ACC_PASS, ACC_SCALES,
-	ACC_NCH
+	ACC_DIFF, ACC_NCH
 };
 
 /* The scales a pixel can be sampled at, in the order they are used. */
@@ -75,30 +85,24 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 		       size_t errlen);
 
 /*
- * The largest relative squared difference between pixel i's mean and one
- * of its eight neighbours' (mean over R, G, B of difference^2 over the
- * brighter one's value^2 + 0.01): how much an edge through the pixel could
- * be worth.
- */
-double accum_contrast(const struct image *acc, size_t i, const float fit[3]);
-
-/*
  * The estimated relative squared error of pixel i's mean (a term of
  * relMSE: squared error over value^2 + 0.01; 1 when unknown), the largest
  * of two estimates:
- * - noise: the regression's error estimate press (mean over R, G, B of the
- *   squared error, NaN if none; fit is its R, G, B) and, once the pixel
- *   has 4 or more samples, its sample variance over its sample count: the
- *   smaller of the two, as both overestimate (PRESS counts detail the
- *   regression cannot model, the variance of stratified samples exceeds
- *   that of their mean);
- * - edges: an edge between all the sample positions is invisible to both,
- *   so with contrast from accum_contrast() and s the pixel's finest scale,
- *   contrast / (12 s^2), the expected squared error of placing an edge on
- *   an s x s grid.
+ * - noise: once the pixel has had a fold, diff, the 'diff' channel
+ *   averaged over the pixel's neighbourhood (NaN when there is none; see
+ *   plan_pixel_errors()); before that, the regression's error estimate press
+ *   (mean over R, G, B of the squared error, NaN if none; fit is its R, G, B);
+ * - edges: an edge between all the sample positions is invisible to both.
+ *   Where a pixel differs from a neighbour by more than the two pixels'
+ *   own samples spread over, the edge between them may lie in the strip
+ *   next to the neighbour that the pixel's finest grid (s x s) has not
+ *   sampled, of width 1/(2s): the expected relative squared error of a
+ *   uniformly placed edge there (relative to what the value would then be,
+ *   so a dark pixel beside a light is not charged the light's brightness
+ *   over its own darkness).
  */
 double accum_pixel_error(const struct image *acc, size_t i, double press, const float fit[3],
-			 double contrast);
+			 double diff);
 
 /* What the final image holds per pixel. */
 enum accum_final {

@@ -33,14 +33,42 @@ const char *plan_outcome_name(enum plan_outcome o)
 	return "?";
 }
 
+/* The neighbourhood the fold differences are averaged over. */
+#define DIFF_RADIUS 2
+
+/* The 'diff' estimate of pixel i averaged over the 5x5 pixels around it
+ * that have one (a single pixel's is a difference of two noisy means:
+ * about three degrees of freedom); NaN when none has. */
+static double diff_around(const struct image *acc, int x, int y)
+{
+	double sum = 0.0;
+	int cnt = 0;
+	for (int j = y - DIFF_RADIUS; j <= y + DIFF_RADIUS; j++) {
+		if (j < 0 || j >= acc->h)
+			continue;
+		for (int k = x - DIFF_RADIUS; k <= x + DIFF_RADIUS; k++) {
+			if (k < 0 || k >= acc->w)
+				continue;
+			float d = acc->px[((size_t)j * acc->w + k) * ACC_NCH + ACC_DIFF];
+			if (isfinite(d)) {
+				sum += d;
+				cnt++;
+			}
+		}
+	}
+	return cnt ? sum / cnt : NAN;
+}
+
 double plan_pixel_errors(const struct image *acc, const float *press, const float *fit,
 			 double *e)
 {
 	size_t n = (size_t)acc->w * acc->h;
 	double sum = 0.0;
 	for (size_t i = 0; i < n; i++) {
-		e[i] = accum_pixel_error(acc, i, press[i], fit + 3 * i,
-					 accum_contrast(acc, i, fit + 3 * i));
+		const float *o = acc->px + i * ACC_NCH;
+		double diff = isfinite(o[ACC_DIFF]) ?
+			diff_around(acc, (int)(i % (size_t)acc->w), (int)(i / (size_t)acc->w)) : NAN;
+		e[i] = accum_pixel_error(acc, i, press[i], fit + 3 * i, diff);
 		sum += e[i];
 	}
 	return n ? sum / n : 0.0;

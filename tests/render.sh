@@ -6,7 +6,7 @@
 #
 # usage: tests/render.sh BUILD_DIR
 #
-# References (resolution scale 12: 144 samples per pixel, antialiasing off,
+# References (resolution scale 24: 576 samples per pixel, antialiasing off,
 # box-averaged) are rendered once and cached in
 # ${POVPRESS_CACHE:-$HOME/.cache/povpress}/testref, keyed by the scene's
 # contents, the size and POV-Ray's version.
@@ -50,7 +50,7 @@ no_povray_left() { # no povray process whose command line mentions $1
 
 POV_VERSION=$(povray --version 2>&1 | head -n 1)
 reference() { # reference SCENE: print the cached reference's path, rendering it if need be
-	local scene=$1 s=12 key dest tmp
+	local scene=$1 s=24 key dest tmp
 	key=$({
 		echo "povpress test reference 1 ${W}x$H s$s"
 		echo "$POV_VERSION"
@@ -72,8 +72,8 @@ reference() { # reference SCENE: print the cached reference's path, rendering it
 
 # uniform SCENE CPU REF: the relMSE of the finest uniform resolution-scaled
 # render (antialiasing off, one thread) that costs at most CPU seconds,
-# printed as "SCALE CPU RELMSE"; scale 1 if even that costs more.  Scales
-# up to 10 (12 would be the reference itself).
+# printed as "SCALE CPU RELMSE"; scale 1 if even that costs more.
+# Scales up to 10.
 uniform() {
 	local scene=$1 budget=$2 ref=$3 s best="" t
 	for s in 1 2 3 4 5 6 7 8 9 10; do
@@ -134,7 +134,7 @@ fault "output path that is a directory: named" "is a directory" "$T/ro/none" \
 
 # --- the loop on bundled scenes: better than the base pass and than a
 # uniform render of the same CPU cost ---------------------------------------
-for name in ${RENDER_TEST_SCENES:-soft_shadows glossy_reflection}; do
+for name in ${RENDER_TEST_SCENES:-soft_shadows glossy_reflection thin_geometry}; do
 	scene="$SC/$name.pov"
 	ref=$(reference "$scene") || { bad "$name: reference render failed"; continue; }
 	"$PP" render "$scene" -o "$T/$name.exr" -W $W -H $H --target 1e-3 -q \
