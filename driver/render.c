@@ -58,6 +58,9 @@ static const char usage[] =
 	"                        invocation waits ~0.65 s on POV-Ray itself)\n"
 	"  --timeout SECONDS     per POV-Ray run; one retry after a crash or timeout\n"
 	"                        (default: 60 + 20 x the base pass)\n"
+	"  --cost-job S          the planner's cost of one POV-Ray run, seconds, and\n"
+	"  --cost-sample S       of one sample (default: measured on the base pass and\n"
+	"                        rounded to powers of two; the report has them)\n"
 	"  --workdir DIR         keep intermediate files here (default OUT.exr.work)\n"
 	"  --keep-workdir        do not remove the work directory after success\n"
 	"  --resume              continue the run the work directory holds\n"
@@ -109,6 +112,7 @@ struct run {
 	char povdir[PATH_MAX];	/* workdir as POV-Ray can be told it */
 	int w, h, max_passes, jobs, quiet, verbose, keep, resume, user_workdir;
 	double target, budget, timeout;
+	double user_cost_job, user_cost_sample;	/* 0: measure */
 	enum accum_final final;
 	const char *const *extra;
 	size_t nextra;
@@ -596,6 +600,10 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	 * POV-Ray's latency in one of the pool's slots: in core-seconds that
 	 * is the latency times cores over slots */
 	r->cost_job = (setup > 1e-3 ? quantise(setup, 1.0) : 0.0) + lat * r->cores / r->jobs;
+	if (r->user_cost_job > 0.0)
+		r->cost_job = r->user_cost_job;
+	if (r->user_cost_sample > 0.0)
+		r->cost_sample = r->user_cost_sample;
 	if (r->timeout <= 0.0)
 		r->timeout = 60.0 + 20.0 * res.wall_s;
 	struct pass_rec p = {0};
@@ -881,6 +889,12 @@ int cmd_render(int argc, char **argv)
 				goto bad;
 		} else if (!strcmp(a, "--budget")) {
 			if (parse_double(argv[++i], 1e-3, 1e9, &r.budget))
+				goto bad;
+		} else if (!strcmp(a, "--cost-job")) {
+			if (parse_double(argv[++i], 1e-9, 1e6, &r.user_cost_job))
+				goto bad;
+		} else if (!strcmp(a, "--cost-sample")) {
+			if (parse_double(argv[++i], 1e-15, 1e3, &r.user_cost_sample))
 				goto bad;
 		} else if (!strcmp(a, "--timeout")) {
 			if (parse_double(argv[++i], 1e-3, 1e9, &r.timeout))
