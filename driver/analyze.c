@@ -1,6 +1,7 @@
 /*
  * analyze.c - `povpress analyze`: the regression's view of one image.
  */
+#include "driver/args.h"
 #include "driver/commands.h"
 #include "driver/image.h"
 #include "regression/lpr.h"
@@ -40,17 +41,6 @@ static const char usage[] =
 	"  -v, --verbose       print timing and summary figures to stderr\n"
 	"  -h, --help          this text\n";
 
-static int parse_int(const char *s, int lo, int hi, int *out)
-{
-	char *end;
-	errno = 0;
-	long v = strtol(s, &end, 10);
-	if (errno || end == s || *end || v < lo || v > hi)
-		return -1;
-	*out = (int)v;
-	return 0;
-}
-
 /* "2,5,8" -> p->radii; -1 on anything else. */
 static int parse_radii(const char *s, struct lpr_params *p)
 {
@@ -61,7 +51,7 @@ static int parse_radii(const char *s, struct lpr_params *p)
 	int n = 0;
 	for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok;
 	     tok = strtok_r(NULL, ",", &save)) {
-		if (n == 8 || parse_int(tok, 1, LPR_MAXRADIUS, &p->radii[n]))
+		if (n == 8 || args_int(tok, 1, LPR_MAXRADIUS, &p->radii[n]))
 			return -1;
 		n++;
 	}
@@ -155,7 +145,7 @@ int cmd_analyze(int argc, char **argv)
 			const char *v = argv[++i];
 			if (!strcmp(v, "auto"))
 				p.order = -1;
-			else if (parse_int(v, 0, 2, &p.order)) {
+			else if (args_int(v, 0, 2, &p.order)) {
 				fprintf(stderr, "povpress analyze: bad --order '%s' (auto, 0, 1 or 2)\n", v);
 				return 2;
 			}
@@ -163,7 +153,7 @@ int cmd_analyze(int argc, char **argv)
 			const char *v = argv[++i];
 			if (!strcmp(v, "auto"))
 				p.radius = 0;
-			else if (parse_int(v, 1, LPR_MAXRADIUS, &p.radius)) {
+			else if (args_int(v, 1, LPR_MAXRADIUS, &p.radius)) {
 				fprintf(stderr, "povpress analyze: bad --radius '%s' (auto or 1..%d)\n", v,
 					LPR_MAXRADIUS);
 				return 2;
@@ -177,7 +167,7 @@ int cmd_analyze(int argc, char **argv)
 			}
 		} else if (!strcmp(a, "--threads") && more) {
 			const char *v = argv[++i];
-			if (parse_int(v, 1, 1024, &p.nthreads)) {
+			if (args_int(v, 1, 1024, &p.nthreads)) {
 				fprintf(stderr, "povpress analyze: bad --threads '%s'\n", v);
 				return 2;
 			}

@@ -114,6 +114,16 @@ static int inside(const struct plan_region *in, const struct plan_region *out)
  * grid is made coarser. */
 #define PACK_MAX_RUNS 400
 
+/* Whether tile (tx, ty) of the grid holds a marked pixel. */
+static int tile_occupied(const unsigned char *mark, int w, int h, int tile, int tx, int ty)
+{
+	for (int y = ty * tile; y < (ty + 1) * tile && y < h; y++)
+		for (int x = tx * tile; x < (tx + 1) * tile && x < w; x++)
+			if (mark[(size_t)y * w + x])
+				return 1;
+	return 0;
+}
+
 /*
  * Pack the chosen pixels of one scale (mark[i] set, gain[i] their gains)
  * into rectangles appended to *rs.  tile is the grid.  Returns 0, -1 when
@@ -136,30 +146,15 @@ static int pack(const struct plan_params *p, int w, int h, int s, const unsigned
 	for (int ty = 0; ty < th; ty++) {
 		int tx = 0;
 		while (tx < tw) {
-			int occ = 0;
-			for (int y = ty * tile; y < (ty + 1) * tile && y < h && !occ; y++)
-				for (int x = tx * tile; x < (tx + 1) * tile && x < w; x++)
-					if (mark[(size_t)y * w + x]) {
-						occ = 1;
-						break;
-					}
-			if (!occ) {
+			if (!tile_occupied(mark, w, h, tile, tx, ty)) {
 				open_of[tx] = -1;
 				tx++;
 				continue;
 			}
 			int t0 = tx;
-			for (tx++; tx < tw; tx++) {
-				int o2 = 0;
-				for (int y = ty * tile; y < (ty + 1) * tile && y < h && !o2; y++)
-					for (int x = tx * tile; x < (tx + 1) * tile && x < w; x++)
-						if (mark[(size_t)y * w + x]) {
-							o2 = 1;
-							break;
-						}
-				if (!o2)
+			for (tx++; tx < tw; tx++)
+				if (!tile_occupied(mark, w, h, tile, tx, ty))
 					break;
-			}
 			int x0 = t0 * tile, x1 = tx * tile - 1;
 			if (x1 >= w)
 				x1 = w - 1;

@@ -4,6 +4,7 @@
  * renders can run anywhere (sh, xargs -P, GNU parallel, a farm).
  */
 #include "driver/accum.h"
+#include "driver/args.h"
 #include "driver/commands.h"
 #include "driver/errbuf.h"
 #include "driver/image.h"
@@ -77,28 +78,6 @@ static const char merge_usage[] =
 	"  --skip-missing      a region whose image is missing keeps its previous\n"
 	"                      estimate (with a warning) instead of failing\n"
 	"  -h, --help          this text\n";
-
-static int parse_double(const char *s, double lo, double hi, double *out)
-{
-	char *end;
-	errno = 0;
-	double v = strtod(s, &end);
-	if (errno || end == s || *end || !(v >= lo && v <= hi))
-		return -1;
-	*out = v;
-	return 0;
-}
-
-static int parse_int(const char *s, int lo, int hi, int *out)
-{
-	char *end;
-	errno = 0;
-	long v = strtol(s, &end, 10);
-	if (errno || end == s || *end || v < lo || v > hi)
-		return -1;
-	*out = (int)v;
-	return 0;
-}
 
 /* The analysis's fit (R, G, B) and error, w*h*3 and w*h floats. */
 static int read_analysis(const char *path, struct image *img, float **fit, float **press,
@@ -196,25 +175,25 @@ int cmd_plan(int argc, char **argv)
 		} else if (!strcmp(a, "--radiosity")) {
 			radiosity = argv[++i];
 		} else if (!strcmp(a, "--pass")) {
-			if (parse_int(argv[++i], 0, 99, &pass))
+			if (args_int(argv[++i], 0, 99, &pass))
 				goto bad;
 		} else if (!strcmp(a, "--threads")) {
-			if (parse_int(argv[++i], 1, 1024, &threads))
+			if (args_int(argv[++i], 1, 1024, &threads))
 				goto bad;
 		} else if (!strcmp(a, "--max-regions")) {
-			if (parse_int(argv[++i], 1, 100000, &pp.max_regions))
+			if (args_int(argv[++i], 1, 100000, &pp.max_regions))
 				goto bad;
 		} else if (!strcmp(a, "--target")) {
-			if (parse_double(argv[++i], 1e-12, 1e6, &pp.target))
+			if (args_double(argv[++i], 1e-12, 1e6, &pp.target))
 				goto bad;
 		} else if (!strcmp(a, "--budget")) {
-			if (parse_double(argv[++i], 1e-6, 1e9, &pp.budget))
+			if (args_double(argv[++i], 1e-6, 1e9, &pp.budget))
 				goto bad;
 		} else if (!strcmp(a, "--cost-job")) {
-			if (parse_double(argv[++i], 0.0, 1e6, &pp.cost_job))
+			if (args_double(argv[++i], 0.0, 1e6, &pp.cost_job))
 				goto bad;
 		} else if (!strcmp(a, "--cost-sample")) {
-			if (parse_double(argv[++i], 1e-15, 1e3, &pp.cost_sample))
+			if (args_double(argv[++i], 1e-15, 1e3, &pp.cost_sample))
 				goto bad;
 		} else if (a[0] == '-' && a[1]) {
 			fprintf(stderr, "povpress plan: unknown option '%s'\n%s", a, plan_usage);

@@ -12,6 +12,7 @@
  */
 #define _XOPEN_SOURCE 700	/* realpath */
 #include "driver/accum.h"
+#include "driver/args.h"
 #include "driver/commands.h"
 #include "driver/errbuf.h"
 #include "driver/image.h"
@@ -791,28 +792,6 @@ out:
 	return ret;
 }
 
-static int parse_double(const char *s, double lo, double hi, double *out)
-{
-	char *end;
-	errno = 0;
-	double v = strtod(s, &end);
-	if (errno || end == s || *end || !(v >= lo && v <= hi))
-		return -1;
-	*out = v;
-	return 0;
-}
-
-static int parse_int(const char *s, int lo, int hi, int *out)
-{
-	char *end;
-	errno = 0;
-	long v = strtol(s, &end, 10);
-	if (errno || end == s || *end || v < lo || v > hi)
-		return -1;
-	*out = (int)v;
-	return 0;
-}
-
 /* Check that path's directory exists and is writable, before any work. */
 static int check_writable(const char *what, const char *path, char *err, size_t errlen)
 {
@@ -879,31 +858,31 @@ int cmd_render(int argc, char **argv)
 		} else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
 			r.out = argv[++i];
 		} else if (!strcmp(a, "-W") || !strcmp(a, "--width")) {
-			if (parse_int(argv[++i], 1, 65535, &r.w))
+			if (args_int(argv[++i], 1, 65535, &r.w))
 				goto bad;
 		} else if (!strcmp(a, "-H") || !strcmp(a, "--height")) {
-			if (parse_int(argv[++i], 1, 65535, &r.h))
+			if (args_int(argv[++i], 1, 65535, &r.h))
 				goto bad;
 		} else if (!strcmp(a, "--target")) {
-			if (parse_double(argv[++i], 1e-12, 1e6, &r.target))
+			if (args_double(argv[++i], 1e-12, 1e6, &r.target))
 				goto bad;
 		} else if (!strcmp(a, "--budget")) {
-			if (parse_double(argv[++i], 1e-3, 1e9, &r.budget))
+			if (args_double(argv[++i], 1e-3, 1e9, &r.budget))
 				goto bad;
 		} else if (!strcmp(a, "--cost-job")) {
-			if (parse_double(argv[++i], 1e-9, 1e6, &r.user_cost_job))
+			if (args_double(argv[++i], 1e-9, 1e6, &r.user_cost_job))
 				goto bad;
 		} else if (!strcmp(a, "--cost-sample")) {
-			if (parse_double(argv[++i], 1e-15, 1e3, &r.user_cost_sample))
+			if (args_double(argv[++i], 1e-15, 1e3, &r.user_cost_sample))
 				goto bad;
 		} else if (!strcmp(a, "--timeout")) {
-			if (parse_double(argv[++i], 1e-3, 1e9, &r.timeout))
+			if (args_double(argv[++i], 1e-3, 1e9, &r.timeout))
 				goto bad;
 		} else if (!strcmp(a, "--max-passes")) {
-			if (parse_int(argv[++i], 0, 1000, &r.max_passes))
+			if (args_int(argv[++i], 0, 1000, &r.max_passes))
 				goto bad;
 		} else if (!strcmp(a, "--jobs") || !strcmp(a, "-j")) {
-			if (parse_int(argv[++i], 1, 1024, &r.jobs))
+			if (args_int(argv[++i], 1, 1024, &r.jobs))
 				goto bad;
 		} else if (!strcmp(a, "--workdir")) {
 			r.workdir = argv[++i];

@@ -13,15 +13,7 @@ ROOT=$(cd "$(dirname "$0")/.." && pwd)
 T=$(mktemp -d "${TMPDIR:-/tmp}/povpress-e2e.XXXXXX")
 trap 'rm -rf "$T"' EXIT
 
-passed=0
-failed=0
-ok() { passed=$((passed + 1)); echo "ok   - $1"; }
-bad() { failed=$((failed + 1)); echo "FAIL - $1"; }
-check() { # check DESCRIPTION COMMAND...
-	local d=$1
-	shift
-	if "$@"; then ok "$d"; else bad "$d"; fi
-}
+. "$(dirname "$0")/lib.sh"
 
 # stat IMAGE CHANNEL FIELD: one field (Min, Max, Avg, NanCount, InfCount)
 # of `oiiotool --printstats` for one channel.
@@ -38,10 +30,6 @@ cutstat() {
 order_frac() { # IMAGE GEOMETRY N
 	oiiotool "$1" --ch order --cut "$2" --subc $(($3 - 1)) --clamp:min=0:max=1 \
 		--printstats 2>/dev/null | awk '$1 == "Stats" && $2 == "Avg:" { print $3 }'
-}
-# true when awk says so: num 'EXPR' with a=$2 b=$3 ...
-num() {
-	awk -v a="${2:-0}" -v b="${3:-0}" -v c="${4:-0}" "BEGIN { exit !($1) }"
 }
 cmpval() { # cmpval OUTPUT KEY: value printed by compare
 	awk -v k="$2:" '$1 == k { print $2 }' <<<"$1"

@@ -23,18 +23,7 @@ trap 'rm -rf "$T"' EXIT
 W=80
 H=60
 
-passed=0
-failed=0
-ok() { passed=$((passed + 1)); echo "ok   - $1"; }
-bad() { failed=$((failed + 1)); echo "FAIL - $1"; }
-check() { # check DESCRIPTION COMMAND...
-	local d=$1
-	shift
-	if "$@"; then ok "$d"; else bad "$d"; fi
-}
-num() { # num 'EXPR' a b c: true when awk says so
-	awk -v a="${2:-0}" -v b="${3:-0}" -v c="${4:-0}" "BEGIN { exit !($1) }"
-}
+. "$(dirname "$0")/lib.sh"
 relmse() { # relmse IMAGE REF
 	"$PP" compare "$1" "$2" | awk '$1 == "relmse:" { print $2 }'
 }
