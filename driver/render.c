@@ -579,7 +579,8 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	/* the cost model */
 	const struct pov_stats *st = &res.stats;
 	double trace = (st->have & POV_HAVE_TRACE) ? st->trace.cpu_s : res.cpu_s;
-	double rays = st->rays > 0 ? (double)st->rays : (double)r->w * r->h;
+	/* camera samples: POV-Ray's "Rays" line counts reflected rays too */
+	double rays = st->pixels > 0 ? (double)(st->pixels + st->samples) : (double)r->w * r->h;
 	r->cost_sample = trace / rays;
 	if (!(r->cost_sample > 1e-9))
 		r->cost_sample = 1e-9;
@@ -720,8 +721,14 @@ static int refine_pass(struct run *r, int pass, const struct lpr_result *res, ch
 	r->pool_done = 0;
 	r->pool_total = (int)n;
 	r->pool_pass = pass;
-	progress(r, "pass %d: %zu regions, %ld pixels, %.0f samples", pass, n, pl.pixels,
-		 pl.samples);
+	/* the pass should take its CPU over the cores, or the latency of its
+	 * rounds of jobs, whichever is longer */
+	double rounds = ceil((double)n / po.max_jobs);
+	double cpu_wall = (pl.cost - (double)n * r->cost_job) / (n < (size_t)r->cores ? (double)n :
+								    r->cores);
+	double guess = rounds * r->latency > cpu_wall ? rounds * r->latency : cpu_wall;
+	progress(r, "pass %d: %zu regions, %ld pixels, %.0f samples, about %.1f s", pass, n,
+		 pl.pixels, pl.samples, guess + r->latency);
 	int rc = pov_pool_run(jobs, n, &po, results, err, errlen);
 	if (rc < 0)
 		goto out;
