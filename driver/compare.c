@@ -24,8 +24,9 @@ static const char compare_usage[] =
 	"Pixels that are NaN or infinite in either image are left out, and a\n"
 	"fourth line \"skipped: N\" counts them.\n"
 	"\n"
-	"With --analysis, the output of 'povpress analyze IMAGE.exr' is judged as\n"
-	"a prediction of IMAGE's true error (its error and R, G, B channels):\n"
+	"With --analysis, the output of 'povpress analyze IMAGE.exr' (its error and\n"
+	"R, G, B channels) or the error map of 'povpress render' (its relerror\n"
+	"channel) is judged as a prediction of IMAGE's true error:\n"
 	"\n"
 	"  est_relmse: V  the relMSE the error map predicts for IMAGE\n"
 	"  capture20: V   share of the true error in the 20% of pixels the map\n"
@@ -114,14 +115,25 @@ int cmd_compare(int argc, char **argv)
 	if (analysis) {
 		struct fidelity fd;
 		int ech;
-		if (image_read_exr(analysis, &ana, err, sizeof(err)) ||
-		    image_rgb(&ana, analysis, &fit, err, sizeof(err))) {
+		if (image_read_exr(analysis, &ana, err, sizeof(err))) {
 			fprintf(stderr, "povpress compare: %s\n", err);
 			goto out;
 		}
-		ech = image_channel(&ana, "error");
+		/* a render's error map has its relative error; an analysis has
+		 * the absolute one and the fit to make it relative with */
+		int rel = image_channel(&ana, "relerror") >= 0;
+		if (!rel && image_rgb(&ana, analysis, &fit, err, sizeof(err))) {
+			fprintf(stderr, "povpress compare: %s\n", err);
+			goto out;
+		}
+		ech = image_channel(&ana, rel ? "relerror" : "error");
 		if (ech < 0) {
 			fprintf(stderr, "povpress compare: '%s' has no error channel\n", analysis);
+			goto out;
+		}
+		if (ana.w != img.w || ana.h != img.h) {
+			fprintf(stderr, "povpress compare: '%s' is %dx%d, not %dx%d\n", analysis,
+				ana.w, ana.h, img.w, img.h);
 			goto out;
 		}
 		size_t n = (size_t)ana.w * ana.h;
@@ -132,7 +144,8 @@ int cmd_compare(int argc, char **argv)
 		}
 		for (size_t i = 0; i < n; i++)
 			emap[i] = ana.px[i * ana.nch + ech];
-		int rc = metrics_fidelity(&img, &ref, emap, &fit, &fd, err, sizeof(err));
+		int rc = metrics_fidelity(&img, &ref, emap, rel ? NULL : &fit, &fd, err,
+					  sizeof(err));
 		free(emap);
 		if (rc) {
 			fprintf(stderr, "povpress compare: cannot judge '%s': %s\n", analysis, err);

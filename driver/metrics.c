@@ -83,8 +83,8 @@ int metrics_fidelity(const struct image *img, const struct image *ref, const flo
 		     const struct image *fit, struct fidelity *out, char *err, size_t errlen)
 {
 	memset(out, 0, sizeof(*out));
-	if (img->w != ref->w || img->h != ref->h || fit->w != img->w || fit->h != img->h ||
-	    img->nch != 3 || ref->nch != 3 || fit->nch != 3) {
+	if (img->w != ref->w || img->h != ref->h || img->nch != 3 || ref->nch != 3 ||
+	    (fit && (fit->w != img->w || fit->h != img->h || fit->nch != 3))) {
 		if (err && errlen)
 			snprintf(err, errlen, "the image, reference and analysis differ in size");
 		return -1;
@@ -98,7 +98,8 @@ int metrics_fidelity(const struct image *img, const struct image *ref, const flo
 	}
 	double total = 0.0, est = 0.0;
 	for (size_t i = 0; i < npix; i++) {
-		const float *a = img->px + 3 * i, *b = ref->px + 3 * i, *f = fit->px + 3 * i;
+		const float *a = img->px + 3 * i, *b = ref->px + 3 * i;
+		const float *f = fit ? fit->px + 3 * i : a;
 		double t = 0.0, m2 = 0.0;
 		int ok = isfinite(err_map[i]);
 		for (int c = 0; c < 3; c++) {
@@ -110,7 +111,7 @@ int metrics_fidelity(const struct image *img, const struct image *ref, const flo
 		if (!ok)
 			continue;
 		v[n].truth = t / 3.0;
-		v[n].key = err_map[i] / (m2 / 3.0 + METRICS_RELMSE_EPS);
+		v[n].key = fit ? err_map[i] / (m2 / 3.0 + METRICS_RELMSE_EPS) : err_map[i];
 		total += v[n].truth;
 		est += v[n].key;
 		n++;

@@ -47,7 +47,9 @@ struct fidelity {
 
 /*
  * Compute the fidelity of the estimate err_map (w * h values) with
- * reconstruction fit (RGB, same size) for img against ref (both RGB).
+ * reconstruction fit (RGB, same size) for img against ref (both RGB): the
+ * map is of squared errors, made relative with fit's values.  With fit
+ * NULL the map is already relative (terms of relMSE).
  * Pixels with a non-finite value anywhere are left out.  Returns 0, or -1
  * with a message on a size mismatch, no usable pixel or no memory.
  */

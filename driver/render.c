@@ -58,7 +58,7 @@ static const char usage[] =
 	"  --jobs N              POV-Ray processes at once (default 4 per core: each\n"
 	"                        invocation waits ~0.65 s on POV-Ray itself)\n"
 	"  --timeout SECONDS     per POV-Ray run; one retry after a crash or timeout\n"
-	"                        (default: 60 + 20 x the base pass)\n"
+	"                        (default: 60 + 10 x the dearest region's predicted cost)\n"
 	"  --cost-job S          the planner's cost of one POV-Ray run, seconds, and\n"
 	"  --cost-sample S       of one sample (default: measured on the base pass and\n"
 	"                        rounded to powers of two; the report has them)\n"
@@ -606,8 +606,6 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 		r->cost_job = r->user_cost_job;
 	if (r->user_cost_sample > 0.0)
 		r->cost_sample = r->user_cost_sample;
-	if (r->timeout <= 0.0)
-		r->timeout = 60.0 + 20.0 * res.wall_s;
 	struct pass_rec p = {0};
 	p.pass = 0;
 	p.wall_s = now_s() - t;
@@ -716,6 +714,15 @@ static int refine_pass(struct run *r, int pass, const struct lpr_result *res, ch
 	pov_pool_opts_init(&po);
 	po.max_jobs = r->jobs < (int)n ? r->jobs : (int)n;
 	po.timeout_s = r->timeout;
+	if (po.timeout_s <= 0.0) {
+		/* a minute plus ten times what the dearest region should cost:
+		 * a region at scale 16 can cost far more than the base pass */
+		double worst = 0.0;
+		for (size_t k = 0; k < n; k++)
+			if (pl.regions[k].cost > worst)
+				worst = pl.regions[k].cost;
+		po.timeout_s = 60.0 + 10.0 * worst;
+	}
 	po.on_done = on_done;
 	po.arg = r;
 	r->pool_done = 0;
@@ -1008,8 +1015,6 @@ bad:
 			goto fail;
 		}
 		first_pass = r.passes[r.npasses - 1].pass + 1;
-		if (r.timeout <= 0.0)
-			r.timeout = 60.0 + 20.0 * r.passes[0].wall_s;
 		progress(&r, "resuming after pass %d (%.1f s so far)", first_pass - 1, r.prev_wall);
 	} else {
 		if (mkdir_p(r.workdir, err, sizeof err))
