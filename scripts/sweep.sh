@@ -1,53 +1,61 @@
 #!/usr/bin/env bash
-# How POV-Ray alone trades CPU time for error on the bundled scenes, with its
-# two ways of adding samples per pixel: its own antialiasing (+AM1, +AM2) and
-# resolution scaling (render at s*W x s*H with antialiasing off, box-average
-# each s x s block).  The adaptive renderer uses it to choose how to add
-# samples, and the benchmark as its POV-Ray-alone baseline.
+# The benchmark: `povpress render` against POV-Ray alone, CPU time against
+# error, on the bundled scenes.  POV-Ray alone has two ways of adding samples
+# per pixel: its own antialiasing (+AM1, +AM2) and resolution scaling (render
+# at s*W x s*H with antialiasing off, box-average each s x s block); the
+# lower envelope of all its runs is the bar povpress must beat.
 #
 # usage: scripts/sweep.sh [--quick] [--size WxH] [SCENE.pov ...]
-#        make sweep [SWEEP_ARGS="--quick scenes/media.pov"]
+#        make sweep [SWEEP_ARGS="--quick scenes/media.pov"]; make bench (quick)
 #
 # Default: every scenes/*.pov at 160x120.  Needs build/povpress and
 # build/tools/boxdown (make sweep builds both; $BUILD names another build
 # directory), povray and gnuplot.
 #
 # Reference.  Per scene and size, the scene at its default knobs rendered by
-# resolution scaling: +W(16 W) +H(16 H), antialiasing off, box-averaged by
-# boxdown (256 samples per pixel).  A second one at scale 12 checks it:
-# relMSE(ref16, ref12) is printed for each scene.  --quick uses scales 8 and
-# 6.  References are rendered with one thread per POV-Ray process (so each
-# is bit-reproducible), two processes at a time (one per core), and cached
-# outside the repository in ${POVPRESS_CACHE:-$HOME/.cache/povpress}/ref/,
-# under a hash of the scene file's contents, the size, the scale, the
-# settings and POV-Ray's version: editing a scene makes a new reference.
-# (The hash does not cover files the scene includes.)
+# resolution scaling: +W(25 W) +H(25 H), antialiasing off, box-averaged by
+# boxdown (625 samples per pixel).  A second one at scale 15 checks it:
+# relMSE(ref25, ref15) is printed for each scene.  --quick uses scales 15
+# and 9.  The scales are odd so that no reference sample falls where
+# povpress's region renders sample (scales 2, 4, 8, 16).  References are
+# rendered with one thread per POV-Ray process (so each is bit-reproducible),
+# two processes at a time (one per core), and cached outside the repository
+# in ${POVPRESS_CACHE:-$HOME/.cache/povpress}/ref/, under a hash of the scene
+# file's contents, the size, the scale, the settings and POV-Ray's version:
+# editing a scene makes a new reference.  (The hash does not cover files the
+# scene includes.)
 #
-# Sweep.  One POV-Ray process per run, +WT1, one run at a time, so that CPU
-# times are comparable:
-#   noaa   no antialiasing (-A)
-#   am1    +AM1 +A{0.3,0.1,0.03,0.01,0.0} +R{2,3,4} +J
-#   am2    +AM2, the same thresholds and depths, +J
-#   scale  s = 1, 2, 3, 4: +W(s W) +H(s H) -A, then boxdown
-# (--quick: thresholds 0.3, 0.03, 0.0 and depths 2, 3.)  Every call is
+# Runs, one at a time, so that CPU times are comparable:
+#   noaa      no antialiasing (-A)
+#   am1       +AM1 +A{0.3,0.1,0.03,0.01,0.0} +R{2,3,4} +J
+#   am2       +AM2, the same thresholds and depths, +J
+#   scale     s = 1, 2, 3, 4: +W(s W) +H(s H) -A, then boxdown
+#   povpress  `povpress render` at --target 3e-3, 1e-3, 3e-4, 1e-4 and at
+#             --budget 2, 4, 8 seconds (with --target 1e-6), its defaults
+# (--quick: thresholds 0.3, 0.03, 0.0, depths 2, 3, targets 3e-3, 1e-3,
+# 3e-4, budget 3.)  Every POV-Ray run is one process,
 #   povray -D -GA +FE +WT1 +W.. +H.. +O.. +I<scene> +L<scene's dir> [options]
 # with the paths in double quotes (POV-Ray splits unquoted ones at spaces).
 # Each run records the CPU seconds (user + system) and wall seconds of the
-# POV-Ray process, from bash's `time` (millisecond resolution; GNU time
-# prints only hundredths, too coarse for renders of 0.03 s), and relMSE and
-# PSNR against the reference from `povpress compare`.  The box-averaging of
-# scale runs is not counted (a few milliseconds).
+# process, from bash's `time` (millisecond resolution; GNU time prints only
+# hundredths, too coarse for renders of 0.03 s); for povpress that includes
+# all its POV-Ray children.  relMSE and PSNR against the reference come from
+# `povpress compare`; for povpress also its estimated relMSE and its error
+# map's capture20 and oracle20.  The box-averaging of scale runs is not
+# counted (a few milliseconds).
 #
 # Output, in $BUILD/sweep/:
-#   sweep.csv        scene,method,setting,cpu_s,wall_s,relmse,psnr
+#   sweep.csv        scene,method,setting,cpu_s,wall_s,relmse,psnr,
+#                    est_relmse,capture20,oracle20 (the last three for povpress)
 #   <scene>.png      relMSE against CPU seconds, log-log, one series per
-#                    method, and the lower envelope (the best relMSE any run
-#                    reaches within each CPU time)
+#                    method, povpress's runs, and POV-Ray's lower envelope
+#                    (the best relMSE any POV-Ray run reaches within each
+#                    CPU time)
 #   summary.md       the tables printed at the end, and notes
-#   <scene>/         the runs' images (W x H) and POV-Ray logs
+#   <scene>/         the runs' images (W x H) and logs
 # Progress goes to stderr; the summary tables to stdout.  Interrupted (INT,
-# TERM, HUP), it stops the POV-Ray processes it started (each runs in its
-# own process group) and leaves no partial reference in the cache.
+# TERM, HUP), it stops the processes it started (each runs in its own
+# process group) and leaves no partial reference in the cache.
 set -euo pipefail
 
 usage() {
@@ -88,14 +96,22 @@ W=${BASH_REMATCH[1]}
 H=${BASH_REMATCH[2]}
 ((${#scenes[@]})) || scenes=("$ROOT"/scenes/*.pov)
 
+# Odd reference scales: their sample grids share no position with the grids
+# of povpress's region renders (scales 2, 4, 8, 16) and only the pixel
+# centre with its base pass, so a refined pixel cannot match the reference
+# merely by sampling the same points.
 if ((quick)); then
-	REF_S=8 CHK_S=6
+	REF_S=15 CHK_S=9
 	THRESHOLDS=(0.3 0.03 0.0)
 	DEPTHS=(2 3)
+	TARGETS=(3e-3 1e-3 3e-4)
+	PP_BUDGETS=(3)
 else
-	REF_S=16 CHK_S=12
+	REF_S=25 CHK_S=15
 	THRESHOLDS=(0.3 0.1 0.03 0.01 0.0)
 	DEPTHS=(2 3 4)
+	TARGETS=(3e-3 1e-3 3e-4 1e-4)
+	PP_BUDGETS=(2 4 8)
 fi
 SCALES=(1 2 3 4)
 NPAR=$(nproc 2>/dev/null || echo 2)
@@ -223,6 +239,17 @@ pov_args() {
 	POV=(-D -GA +FE +WT1 "+W$1" "+H$2" "+O\"$3\"" "+I\"$4\"" "+L\"$(dirname "$4")\"")
 }
 
+# timed_povpress TIMEFILE LOG SCENE OUT REPORT OPTIONS...: the same for a
+# `povpress render` run, whose CPU time includes its POV-Ray children (it
+# waits for them).  Its own defaults otherwise: 4 POV-Ray processes per core,
+# one thread each, and all cores for the base pass.
+timed_povpress() {
+	local tf=$1 log=$2 sc=$3 out=$4 rep=$5 TIMEFORMAT='%3U %3S %3R'
+	shift 5
+	{ time "$POVPRESS" render "$sc" -o "$out" -W "$W" -H "$H" -q --report "$rep" "$@" \
+		</dev/null >"$log" 2>&1; } 2>"$tf"
+}
+
 # ---- references
 
 ref_path() { # SCENE S: the cache file of the scene's reference at scale S
@@ -297,7 +324,7 @@ done
 # ---- the sweep
 
 CSV=$OUT/sweep.csv
-echo "scene,method,setting,cpu_s,wall_s,relmse,psnr" >"$CSV.tmp"
+echo "scene,method,setting,cpu_s,wall_s,relmse,psnr,est_relmse,capture20,oracle20" >"$CSV.tmp"
 runs=("noaa|-|noaa|-A")
 for m in 1 2; do
 	for a in "${THRESHOLDS[@]}"; do
@@ -308,6 +335,12 @@ for m in 1 2; do
 done
 for s in "${SCALES[@]}"; do
 	runs+=("scale|$s|scale$s|-A")
+done
+for t in "${TARGETS[@]}"; do
+	runs+=("povpress|target $t|pp-t$t|--target $t")
+done
+for b in "${PP_BUDGETS[@]}"; do
+	runs+=("povpress|budget $b|pp-b$b|--budget $b --target 1e-6")
 done
 total=$((${#scenes[@]} * ${#runs[@]}))
 k=0
@@ -326,8 +359,14 @@ for i in "${!scenes[@]}"; do
 		render=$img
 		((s == 1)) || render=$dir/$tag-hi.exr
 		pov_args $((s * W)) $((s * H)) "$render" "$sc"
-		# shellcheck disable=SC2086 # opts is a list of POV-Ray options
-		job_start timed_povray "$dir/$tag.time" "$dir/$tag.log" "${POV[@]}" $opts
+		if [[ $method == povpress ]]; then
+			# shellcheck disable=SC2086 # opts is a list of povpress options
+			job_start timed_povpress "$dir/$tag.time" "$dir/$tag.log" "$sc" "$img" \
+				"$dir/$tag.json" $opts
+		else
+			# shellcheck disable=SC2086 # opts is a list of POV-Ray options
+			job_start timed_povray "$dir/$tag.time" "$dir/$tag.log" "${POV[@]}" $opts
+		fi
 		if ! job_wait "$JOB"; then
 			tail -n 15 "$dir/$tag.log" >&2
 			die "povray failed on '$sc' ($method $setting); log in $dir/$tag.log"
@@ -341,7 +380,14 @@ for i in "${!scenes[@]}"; do
 		cmp=$("$POVPRESS" compare "$img" "${REF[$sc]}") || die "cannot compare '$img'"
 		relmse=$(sed -n 's/^relmse: //p' <<<"$cmp")
 		psnr=$(sed -n 's/^psnr: //p' <<<"$cmp")
-		echo "$name,$method,$setting,$cpu,$wall,$relmse,$psnr" >>"$CSV.tmp"
+		fid=,,
+		if [[ $method == povpress ]]; then
+			# the loop's own estimate, and how well its error map ranks pixels
+			cmp=$("$POVPRESS" compare "$img" "${REF[$sc]}" --analysis "${img%.exr}.errors.exr") ||
+				die "cannot judge the error map of '$img'"
+			fid="$(sed -n 's/^est_relmse: //p' <<<"$cmp"),$(sed -n 's/^capture20: //p' <<<"$cmp"),$(sed -n 's/^oracle20: //p' <<<"$cmp")"
+		fi
+		echo "$name,$method,$setting,$cpu,$wall,$relmse,$psnr,$fid" >>"$CSV.tmp"
 		printf 'sweep: [%d/%d] %s %s %s: %s s CPU, %s s wall, relMSE %s (%s)\n' \
 			"$k" "$total" "$name" "$method" "$setting" "$cpu" "$wall" "$relmse" \
 			"$(elapsed)" >&2
@@ -362,21 +408,25 @@ for i in "${!scenes[@]}"; do
 		awk -F, -v n="$name" -v m="$m" '$1 == n && $2 == m { print $4, $6, $3 }' \
 			"$CSV" >"$pd/$m.dat"
 	done
-	# the lower envelope: the best relMSE reached at or below each CPU time
-	awk -F, -v n="$name" '$1 == n { print $4, $6 }' "$CSV" | sort -g -k1,1 |
+	awk -F, -v n="$name" '$1 == n && $2 == "povpress" { sub(/^target /, "t ", $3)
+		sub(/^budget /, "b ", $3); print $4, $6, $3 }' "$CSV" | sort -g -k1,1 >"$pd/povpress.dat"
+	# POV-Ray's lower envelope: the best relMSE reached at or below each CPU time
+	awk -F, -v n="$name" '$1 == n && $2 != "povpress" { print $4, $6 }' "$CSV" | sort -g -k1,1 |
 		awk 'NR == 1 || $2 < best { best = $2; print $1, best } { last = $1 }
 		     END { print last, best }' >"$pd/env.dat"
 	gnuplot <<-EOF
 		set terminal $TERM_PNG size 900,640
 		set output '$OUT/$name.png'
-		set title "$name.pov at ${W}x$H: POV-Ray alone, one thread" noenhanced
-		set xlabel 'CPU seconds of the POV-Ray process'
+		set title "$name.pov at ${W}x$H: POV-Ray alone (one thread) and povpress render" noenhanced
+		set xlabel 'CPU seconds (POV-Ray process; povpress and all its POV-Ray children)'
 		set ylabel 'relMSE against the reference ($((REF_S * REF_S)) samples per pixel)'
 		set logscale xy
 		set format y '%.0e'
 		set grid
 		set key outside right top
-		plot '$pd/env.dat' using 1:2 with steps lw 2 lc rgb 'black' title 'lower envelope', \
+		plot '$pd/env.dat' using 1:2 with steps lw 2 lc rgb 'black' title 'POV-Ray lower envelope', \
+			'$pd/povpress.dat' using 1:2 with linespoints pt 5 ps 1.4 lw 2 lc rgb '#9467bd' title 'povpress render', \
+			'$pd/povpress.dat' using 1:2:3 with labels offset 0,-1.2 tc rgb '#9467bd' notitle, \
 			${REFDIFF[$sc]} with lines dt 2 lc rgb 'gray40' title 'ref$REF_S vs ref$CHK_S', \
 			'$pd/noaa.dat' using 1:2 with points pt 7 ps 1.6 lc rgb 'black' title 'no AA', \
 			'$pd/am1.dat' using 1:2 with points pt 6 ps 1.2 lc rgb '#1f77b4' title '+AM1', \
@@ -546,6 +596,57 @@ while IFS=$'\t' read -r name ncpu nrel rest; do
 	}')
 	[[ -z $n ]] || mapfile -t -O "${#notes[@]}" notes <<<"$n"
 done < <(summarize)
+
+# povpress against POV-Ray's best: for each povpress run, the best POV-Ray
+# run that cost no more CPU (the lower envelope at that time) and the ratio
+# of relMSEs; the cheapest POV-Ray run that reached povpress's relMSE and the
+# speed-up (its CPU over povpress's); the error estimate's fidelity.
+pp_table() {
+	awk -F, '
+	NR > 1 && $2 != "povpress" { n = ++cnt[$1]; C[$1, n] = $4; R[$1, n] = $6; S[$1, n] = $2 " " $3 }
+	NR > 1 && $2 == "povpress" { pp[++np] = $0 }
+	function g(x) { return sprintf("%.3g", x) }
+	END {
+		for (k = 1; k <= np; k++) {
+			split(pp[k], f, ",")
+			sc = f[1]; c = f[4]; r = f[6]
+			be = ""; bs = "-"; fe = ""; fs = "-"
+			for (j = 1; j <= cnt[sc]; j++) {
+				if (C[sc, j] <= c && (be == "" || R[sc, j] < be)) { be = R[sc, j]; bs = S[sc, j] }
+				if (R[sc, j] <= r && (fe == "" || C[sc, j] < fe)) { fe = C[sc, j]; fs = S[sc, j] }
+			}
+			ratio = be == "" ? "-" : sprintf("%.2f", r / be)
+			speed = fe == "" ? "none reaches it" : sprintf("%.2fx (%s s, %s)", fe / c, fe, fs)
+			fid = f[8] == "" ? "-" : sprintf("%.2f / %.2f (%.0f%%)", f[9], f[10], 100 * f[9] / f[10])
+			est = f[8] == "" ? "-" : sprintf("%.2f", f[8] / r)
+			printf "| %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s |\n", sc, f[3], c, f[5],
+				g(r), be == "" ? "-" : g(be), bs, ratio, speed, est, fid
+		}
+	}' "$CSV"
+}
+
+echo
+echo "povpress render against POV-Ray's lower envelope (ratio < 1: povpress has the lower relMSE):"
+PPT=$(pp_table)
+echo "$PPT" | awk -F'|' '{ printf "%-18s %-14s cpu %6s  relMSE %-9s POV-Ray %-22s ratio %-5s speed-up %s\n", $2, $3, $4, $6, $7, $8, $9 }'
+{
+	echo
+	echo "## povpress render against POV-Ray's best"
+	echo
+	echo "Each \`povpress render\` run (its defaults: 4 POV-Ray processes per core, one"
+	echo "thread each, the base pass on all cores) is timed as one process: its CPU"
+	echo "includes every POV-Ray child. \"POV-Ray at equal CPU\" is the best POV-Ray run"
+	echo "above (any method) that cost no more CPU, the lower envelope at that time;"
+	echo "the ratio is povpress's relMSE over it (below 1 povpress wins). \"Equal-error"
+	echo "speed-up\" is the CPU of the cheapest POV-Ray run that reached povpress's relMSE"
+	echo "over povpress's CPU (above 1 povpress is faster). \"est/true\" is povpress's"
+	echo "estimated relMSE over the true one; \"capture20\" the share of the true error in"
+	echo "the 20% of pixels its error map ranks highest, next to an oracle's share."
+	echo
+	echo "| scene | run | CPU s | wall s | relMSE | POV-Ray at equal CPU | ratio | equal-error speed-up | est/true | capture20 / oracle |"
+	echo "|---|---|---|---|---|---|---|---|---|---|"
+	echo "$PPT"
+} >>"$SUM"
 
 {
 	echo
