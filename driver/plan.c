@@ -33,6 +33,10 @@ const char *plan_outcome_name(enum plan_outcome o)
 	return "?";
 }
 
+/* The largest frame a region render may have, pixels (a 4096 x 8192 frame:
+ * 320x240 at scale 16, 640x480 at 8, 1920x1080 at 4). */
+#define PLAN_MAX_FRAME (32.0 * 1024 * 1024)
+
 /* The neighbourhood the fold differences are averaged over. */
 #define DIFF_RADIUS 2
 
@@ -316,10 +320,15 @@ int plan_make(const struct image *acc, const float *press, const float *fit,
 		goto out;
 	}
 
+	/* POV-Ray holds a region render's whole s W x s H frame in memory and
+	 * writes it out, so the scale is capped by the frame's size */
+	int smax = 16;
+	while (smax > 2 && (double)smax * smax * w * h > PLAN_MAX_FRAME)
+		smax /= 2;
 	size_t nc = 0;
 	for (size_t i = 0; i < npx; i++) {
 		int s = accum_next_scale(acc, i);
-		if (!s)
+		if (!s || s > smax)
 			continue;
 		double n = acc->px[i * ACC_NCH + ACC_SAMPLES], m = (double)s * s;
 		double g = e[i] * m / (n + m);

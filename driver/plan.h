@@ -14,7 +14,9 @@
  * whose bounding box costs less than rendering them apart, where a render
  * costs cost_job (one POV-Ray invocation) plus cost_sample for each of its
  * area x s^2 samples.  Every pixel of a rectangle gets the new samples,
- * chosen or not.
+ * chosen or not.  POV-Ray renders a region into a whole s W x s H frame, so
+ * scales whose frame would exceed 32 Mpixels are not used (at 640x480 the
+ * largest scale is 8, at 1920x1080 it is 4).
  */
 #ifndef POVPRESS_PLAN_H
 #define POVPRESS_PLAN_H
