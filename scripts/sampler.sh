@@ -5,7 +5,7 @@
 # and renders that same region both ways, one thread, as region renders
 # (so each run pays what a real region render pays), then measures the CPU
 # seconds of the povray process and the relMSE over the region's pixels
-# against the scene's cached reference from `make sweep` (scale 16).
+# against the scene's cached reference from `make sweep` (scale 25).
 #
 # usage: scripts/sampler.sh [BUILD_DIR] [SCENE...]   (default: four scenes)
 # Writes BUILD_DIR/sampler/sampler.csv and prints, per scene, both methods'
@@ -44,7 +44,7 @@ region_relmse() {
 echo "scene,method,setting,cpu_s,relmse" >"$OUT/sampler.csv"
 for name in "${scenes[@]}"; do
 	scene="$ROOT/scenes/$name.pov"
-	ref=$(ls "$CACHE/$name-${W}x$H-s16-"*.exr 2>/dev/null | head -n 1)
+	ref=$(ls "$CACHE/$name-${W}x$H-s25-"*.exr 2>/dev/null | head -n 1)
 	[[ -n $ref ]] || { echo "sampler: no cached reference for $name (run make sweep)" >&2; continue; }
 	"$PP" render "$scene" -o "$T/r.exr" -W $W -H $H --max-passes 1 --jobs 1 -q \
 		--workdir "$T/w" --keep-workdir -- +WT1
