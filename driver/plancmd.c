@@ -290,12 +290,8 @@ bad:
 	const struct pov_define pd = { "POVPRESS_PASS", passno };
 	base.defines = &pd;
 	base.ndefines = 1;
-	char radopt[PATH_MAX + 8];
-	if (radiosity) {
-		snprintf(radopt, sizeof radopt, "+RF\"%s\"", radiosity);
-		extra[base.nextra++] = "+RFI";
-		extra[base.nextra++] = radopt;
-	}
+	base.radiosity = radiosity;
+	base.radiosity_mode = POV_RAD_LOAD;
 	snprintf(path, sizeof path, "%s/jobs.txt", outdir);
 	FILE *f = open_tmp(path, tmp, sizeof tmp, err, sizeof err);
 	if (!f) {

@@ -265,7 +265,7 @@ int pov_safe_dir(const char *dir, char *out, size_t outlen, char *err, size_t er
 
 /* ---- commands ------------------------------------------------------- */
 
-#define MAX_SUBS 3
+#define MAX_SUBS 4
 
 /* A job made ready to run: the vector and the files around it. */
 struct cmd {
@@ -515,10 +515,61 @@ out:
 	return rc;
 }
 
+/* The radiosity file (+RF) as POV-Ray can be told it: the path, or its
+ * directory linked when unsafe.  *out is malloc'd. */
+static int plan_radiosity(const struct pov_job *job, struct cmd *c, char **out, char *err,
+			  size_t errlen)
+{
+	const char *base;
+	char *dir, *real = NULL, *link = NULL;
+	int rc = -1;
+
+	*out = NULL;
+	if (path_safe(job->radiosity)) {
+		*out = strdup(job->radiosity);
+		if (!*out)
+			errbuf_printf(err, errlen, "out of memory");
+		return *out ? 0 : -1;
+	}
+	dir = split_path(job->radiosity, &base);
+	if (!dir) {
+		errbuf_printf(err, errlen, "out of memory");
+		return -1;
+	}
+	if (!*base || !path_safe(base)) {
+		errbuf_printf(err, errlen, "cannot pass radiosity file '%s' to povray: its name has "
+			      "a double quote or a non-ASCII byte", job->radiosity);
+		goto out;
+	}
+	real = realpath(dir, NULL);
+	if (!real) {
+		errbuf_printf(err, errlen, "cannot use radiosity file '%s': %s", job->radiosity,
+			      strerror(errno));
+		goto out;
+	}
+	if (make_link(job->workdir, real, ".d", dir, &link, err, errlen))
+		goto out;
+	*out = xprintf("%s/%s", link, base);
+	if (!*out || cmd_sub(c, link, dir)) {
+		errbuf_printf(err, errlen, "out of memory");
+		goto out;
+	}
+	rc = 0;
+out:
+	if (rc) {
+		free(*out);
+		*out = NULL;
+	}
+	free(dir);
+	free(real);
+	free(link);
+	return rc;
+}
+
 static int cmd_build(const struct pov_job *job, struct cmd *c, char *err, size_t errlen)
 {
 	const struct pov_region *r = job->region;
-	char *iarg = NULL, *larg = NULL;
+	char *iarg = NULL, *larg = NULL, *rarg = NULL;
 	int from_env;
 
 	memset(c, 0, sizeof(*c));
@@ -559,7 +610,14 @@ static int cmd_build(const struct pov_job *job, struct cmd *c, char *err, size_t
 			return -1;
 		}
 	}
-	if (plan_scene(job, c, &iarg, &larg, err, errlen) || plan_output(job, c, err, errlen))
+	if (job->radiosity && job->radiosity_mode != POV_RAD_SAVE &&
+	    job->radiosity_mode != POV_RAD_LOAD) {
+		errbuf_printf(err, errlen, "radiosity file '%s' is neither saved nor loaded",
+			      job->radiosity);
+		return -1;
+	}
+	if (plan_scene(job, c, &iarg, &larg, err, errlen) || plan_output(job, c, err, errlen) ||
+	    (job->radiosity && plan_radiosity(job, c, &rarg, err, errlen)))
 		goto fail;
 
 	if (cmd_push(c, strdup(binary_name(job, &from_env))) || cmd_push(c, strdup("-D")) ||
@@ -577,6 +635,9 @@ static int cmd_build(const struct pov_job *job, struct cmd *c, char *err, size_t
 	if (cmd_push(c, xprintf("+L\"%s\"", larg)) || cmd_push(c, xprintf("+I\"%s\"", iarg)) ||
 	    cmd_push(c, xprintf("+O\"%s\"", c->povout)))
 		goto oom;
+	if (rarg && (cmd_push(c, strdup(job->radiosity_mode == POV_RAD_SAVE ? "+RFO" : "+RFI")) ||
+		     cmd_push(c, xprintf("+RF\"%s\"", rarg))))
+		goto oom;
 	for (size_t i = 0; i < job->ndefines; i++)
 		if (cmd_push(c, xprintf("Declare=%s=%s", job->defines[i].name,
 					job->defines[i].value)))
@@ -586,12 +647,14 @@ static int cmd_build(const struct pov_job *job, struct cmd *c, char *err, size_t
 			goto oom;
 	free(iarg);
 	free(larg);
+	free(rarg);
 	return 0;
 oom:
 	errbuf_printf(err, errlen, "out of memory");
 fail:
 	free(iarg);
 	free(larg);
+	free(rarg);
 	cmd_release(c);
 	return -1;
 }

@@ -11,6 +11,8 @@
  *              +L"<scene dir>" +I"<scene>" +O"<output>"
  *              [Declare=NAME=VALUE ...] [extra options ...]
  *
+ *   and, with job->radiosity, +RFO or +RFI and +RF"<file>" after +O.
+ *
  *   -D: no display window.  +FE: OpenEXR output.  -GR and -V silence the
  *   option summaries and the progress counter; the statistics stream (on
  *   stderr, which is where POV-Ray writes everything) and the warning and
@@ -27,7 +29,7 @@
  *   with a safe name is made in the job's work directory (job->workdir,
  *   which must then be given and be itself safe): a link to the scene file,
  *   a link to the scene's directory for +L, and a link to the output's
- *   directory.  POV-Ray replaces an existing output file by unlinking it, so
+ *   directory or the radiosity file's (whose own name must be safe).  POV-Ray replaces an existing output file by unlinking it, so
  *   the output itself is never linked: when its file name is unsafe or does
  *   not end in ".exr" (POV-Ray would append ".exr"), POV-Ray writes to a
  *   stand-in name in the output's directory that is renamed to the output
@@ -98,6 +100,12 @@ struct pov_job {
 					 * NULL when no path needs one */
 	const char *povray;		/* the binary; NULL: $POVPRESS_POVRAY or
 					 * "povray" */
+	const char *radiosity;		/* radiosity data file (+RF), or NULL */
+	enum pov_radiosity {
+		POV_RAD_SAVE = 1,	/* +RFO: write the samples computed */
+		POV_RAD_LOAD,		/* +RFI: start from the file's samples */
+	} radiosity_mode;		/* with radiosity; POV-Ray ignores both
+					 * options when the scene has none */
 };
 
 /* What POV-Ray's statistics report about one run. */

@@ -111,6 +111,7 @@ struct run {
 	/* options */
 	const char *scene, *out, *workdir, *error_map, *report;
 	char povdir[PATH_MAX];	/* workdir as POV-Ray can be told it */
+	char radfile[PATH_MAX + 16];	/* the base pass's radiosity data, in workdir */
 	int w, h, max_passes, jobs, quiet, verbose, keep, resume, user_workdir;
 	double target, budget, timeout;
 	double user_cost_job, user_cost_sample;	/* 0: measure */
@@ -355,6 +356,9 @@ static void base_job(const struct run *r, struct pov_job *job, const char **extr
 	job->extra = extra;
 	job->nextra = r->nextra;
 	job->workdir = r->povdir;
+	/* region renders load the radiosity the base pass saved */
+	job->radiosity = r->radiosity ? r->radfile : NULL;
+	job->radiosity_mode = POV_RAD_LOAD;
 	for (size_t k = 0; k < r->nextra; k++)
 		extra[k] = r->extra[k];
 }
@@ -535,7 +539,6 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	}
 	struct pov_job job;
 	base_job(r, &job, extra, r->cores);
-	char radfile[PATH_MAX + 32];
 	char out[PATH_MAX];
 	snprintf(out, sizeof out, "%s", wpath(r, "base.exr"));
 	job.output = out;
@@ -544,10 +547,9 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	job.ndefines = 1;
 	/* antialiasing off: the base pass is one sample at each pixel centre;
 	 * radiosity, if the scene has any, is saved for the region renders */
-	snprintf(radfile, sizeof radfile, "+RF\"%s/radiosity.rca\"", r->povdir);
 	extra[job.nextra++] = "-A";
-	extra[job.nextra++] = "+RFO";
-	extra[job.nextra++] = radfile;
+	job.radiosity = r->radfile;
+	job.radiosity_mode = POV_RAD_SAVE;
 	struct pov_pool_opts po;
 	pov_pool_opts_init(&po);
 	po.max_jobs = 1;
@@ -673,7 +675,6 @@ static int refine_pass(struct run *r, int pass, const struct lpr_result *res, ch
 	char **outs = calloc(n, sizeof(char *));
 	struct pov_result *results = calloc(n, sizeof(*results));
 	const char **bextra = calloc(r->nextra + 4, sizeof(char *));
-	char radfile[PATH_MAX + 32];
 	int ret = -1;
 	if (!jobs || !regs || !extras || !outs || !results || !bextra) {
 		errbuf_printf(err, errlen, "out of memory");
@@ -686,11 +687,6 @@ static int refine_pass(struct run *r, int pass, const struct lpr_result *res, ch
 	const struct pov_define pd = { "POVPRESS_PASS", passno };
 	base.defines = &pd;
 	base.ndefines = 1;
-	if (r->radiosity) {
-		snprintf(radfile, sizeof radfile, "+RF\"%s/radiosity.rca\"", r->povdir);
-		bextra[base.nextra++] = "+RFI";
-		bextra[base.nextra++] = radfile;
-	}
 	for (size_t k = 0; k < n; k++) {
 		char name[64];
 		snprintf(name, sizeof name, "p%02d-r%03zu-s%d.exr", pass, k, pl.regions[k].scale);
@@ -948,6 +944,7 @@ bad:
 		snprintf(wdir, sizeof wdir, "%s.work", r.out);
 		r.workdir = wdir;
 	}
+	snprintf(r.radfile, sizeof r.radfile, "%s/radiosity.rca", r.workdir);
 	r.cores = pov_cpu_count();
 	if (!r.jobs)
 		r.jobs = 4 * r.cores;

@@ -327,6 +327,63 @@ static void test_argv_order_and_quoting(void **state)
 	pov_argv_free(NULL);
 }
 
+/* The radiosity file: +RFO or +RFI and +RF"file" after +O; a directory
+ * POV-Ray cannot be told is reached through a link. */
+static void test_argv_radiosity(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], work[PATH_MAX], rad[PATH_MAX],
+	     odd[PATH_MAX], want[PATH_MAX + 8], target[PATH_MAX], err[512];
+	struct pov_job job = { 0 };
+	char **argv;
+	int argc;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "rad"), "s.pov");
+	mkdir_p(scratch(work, sizeof(work), "rad/work"));
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "rad/o.exr");
+	job.width = 16;
+	job.height = 12;
+	job.workdir = work;
+	job.radiosity = scratch(rad, sizeof(rad), "rad/r.rca");
+	job.radiosity_mode = POV_RAD_SAVE;
+	assert_int_equal(pov_argv_build(&job, &argv, &argc, err, sizeof(err)), 0);
+	snprintf(want, sizeof(want), "+RF\"%s\"", rad);
+	assert_int_equal(argc, 12);
+	assert_string_equal(argv[10], "+RFO");
+	assert_string_equal(argv[11], want);
+	pov_argv_free(argv);
+
+	job.radiosity_mode = POV_RAD_LOAD;
+	mkdir_p(scratch(odd, sizeof(odd), "rad/say \"cheese\""));
+	job.radiosity = scratch(rad, sizeof(rad), "rad/say \"cheese\"/r.rca");
+	assert_int_equal(pov_argv_build(&job, &argv, &argc, err, sizeof(err)), 0);
+	assert_string_equal(argv[10], "+RFI");
+	assert_true(strncmp(argv[11], "+RF\"", 4) == 0);
+	/* one pair of quotes, none inside */
+	assert_true(strchr(argv[11] + 4, '"') == argv[11] + strlen(argv[11]) - 1);
+	/* the link's directory is the odd one */
+	snprintf(want, sizeof(want), "%s", argv[11] + 4);
+	want[strlen(want) - 1] = '\0';			/* the closing quote */
+	*strrchr(want, '/') = '\0';			/* the link itself */
+	ssize_t n = readlink(want, target, sizeof(target) - 1);
+	assert_true(n > 0);
+	target[n] = '\0';
+	size_t tl = strlen(target), ol = strlen("/say \"cheese\"");
+	assert_true(tl > ol);
+	assert_string_equal(target + tl - ol, "/say \"cheese\"");
+	pov_argv_free(argv);
+
+	/* a mode that is neither fails; so does an unsafe file name */
+	job.radiosity_mode = 0;
+	assert_int_equal(pov_argv_build(&job, &argv, NULL, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "neither saved nor loaded"));
+	job.radiosity_mode = POV_RAD_LOAD;
+	job.radiosity = scratch(rad, sizeof(rad), "rad/r\".rca");
+	assert_int_equal(pov_argv_build(&job, &argv, NULL, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "radiosity file"));
+}
+
 static void test_argv_region(void **state)
 {
 	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512];
@@ -1293,6 +1350,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_argv_order_and_quoting),
+		cmocka_unit_test(test_argv_radiosity),
 		cmocka_unit_test(test_argv_region),
 		cmocka_unit_test(test_argv_bad_jobs),
 		cmocka_unit_test(test_argv_links),
