@@ -287,9 +287,25 @@ static int by_position(const void *a, const void *b)
 int plan_make(const struct image *acc, const float *press, const float *fit,
 	      const struct plan_params *p, struct plan *out, char *err, size_t errlen)
 {
+	size_t npx = (size_t)acc->w * acc->h;
+	double *e = malloc(npx * sizeof(*e));
+	if (!e) {
+		memset(out, 0, sizeof(*out));
+		errbuf_printf(err, errlen, "out of memory planning a %dx%d image", acc->w, acc->h);
+		return -1;
+	}
+	plan_pixel_errors(acc, press, fit, e);
+	int rc = plan_make_from(acc, e, p, out, err, errlen);
+	free(e);
+	return rc;
+}
+
+int plan_make_from(const struct image *acc, const double *e, const struct plan_params *p,
+		   struct plan *out, char *err, size_t errlen)
+{
 	const int w = acc->w, h = acc->h;
 	const size_t npx = (size_t)w * h;
-	double *e = NULL, *gain = NULL;
+	double *gain = NULL;
 	struct cand *cand = NULL;
 	unsigned char *mark = NULL;
 	int ret = -1;
@@ -302,17 +318,19 @@ int plan_make(const struct image *acc, const float *press, const float *fit,
 		errbuf_printf(err, errlen, "bad planning parameters");
 		return -1;
 	}
-	e = malloc(npx * sizeof(*e));
 	gain = calloc(npx, sizeof(*gain));
 	cand = malloc(npx * sizeof(*cand));
 	mark = malloc(npx);
 	out->scale = calloc(npx, sizeof(float));
 	out->chosen = calloc(npx, sizeof(float));
-	if (!e || !gain || !cand || !mark || !out->scale || !out->chosen) {
+	if (!gain || !cand || !mark || !out->scale || !out->chosen) {
 		errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
 		goto out;
 	}
-	out->est_relmse = plan_pixel_errors(acc, press, fit, e);
+	double sum = 0.0;
+	for (size_t i = 0; i < npx; i++)
+		sum += e[i];
+	out->est_relmse = npx ? sum / (double)npx : 0.0;
 	out->est_after = out->est_relmse;
 	if (out->est_relmse <= p->target) {
 		out->outcome = PLAN_TARGET_MET;
@@ -436,7 +454,6 @@ int plan_make(const struct image *acc, const float *press, const float *fit,
 	out->outcome = PLAN_REFINE;
 	ret = 0;
 out:
-	free(e);
 	free(gain);
 	free(cand);
 	free(mark);

@@ -82,7 +82,11 @@ const char *plan_outcome_name(enum plan_outcome o);
 double plan_pixel_errors(const struct image *acc, const float *press, const float *fit,
 			 double *e);
 
-/* Plan one pass.  press and fit as for plan_pixel_errors(). */
+/* Plan one pass from the pixels' estimated errors e (plan_pixel_errors()). */
+int plan_make_from(const struct image *acc, const double *e, const struct plan_params *p,
+		   struct plan *out, char *err, size_t errlen);
+
+/* The same from the analysis: press and fit as for plan_pixel_errors(). */
 int plan_make(const struct image *acc, const float *press, const float *fit,
 	      const struct plan_params *p, struct plan *out, char *err, size_t errlen);
 

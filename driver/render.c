@@ -121,14 +121,16 @@ struct run {
 	/* state */
 	int cores, tty;
 	char path[PATH_MAX];
-	double t0, cpu0;
-	double prev_wall, prev_cpu, prev_driver;	/* from a resumed run */
+	double t0;
+	double prev_wall;	/* wall seconds of the passes before a resume */
 	double cost_job, cost_sample, latency;
 	int radiosity;
 	struct pass_rec *passes;
 	size_t npasses;
 	const char *stop;
 	struct image acc;
+	double *est;		/* w*h: each pixel's estimated relative error, from
+				 * the latest analysis of acc (plan_pixel_errors()) */
 	/* progress while a pool runs */
 	int pool_done, pool_total, pool_pass;
 };
@@ -326,11 +328,8 @@ static int load_progress(struct run *r, char *err, size_t errlen)
 		errbuf_printf(err, errlen, "cannot resume: '%s' is damaged", wpath(r, "progress.txt"));
 		return -1;
 	}
-	for (size_t k = 0; k < r->npasses; k++) {
+	for (size_t k = 0; k < r->npasses; k++)
 		r->prev_wall += r->passes[k].wall_s;
-		r->prev_cpu += r->passes[k].cpu_s;
-		r->prev_driver += r->passes[k].driver_cpu_s;
-	}
 	return 0;
 }
 
@@ -423,14 +422,9 @@ static int write_error_map(struct run *r, const struct lpr_result *res, char *er
 	};
 	struct image m = {0};
 	size_t npx = (size_t)r->w * r->h;
-	double *e = malloc(npx * sizeof(double));
-	if (!e || image_init(&m, r->w, r->h, 7, names, err, errlen)) {
-		free(e);
-		if (!e)
-			errbuf_printf(err, errlen, "out of memory");
+	const double *e = r->est;
+	if (image_init(&m, r->w, r->h, 7, names, err, errlen))
 		return -1;
-	}
-	plan_pixel_errors(&r->acc, res->error, res->fit, e);
 	for (size_t i = 0; i < npx; i++) {
 		const float *o = r->acc.px + i * ACC_NCH;
 		float *q = m.px + i * 7;
@@ -447,7 +441,6 @@ static int write_error_map(struct run *r, const struct lpr_result *res, char *er
 		q[5] = o[ACC_PASS];
 		q[6] = o[ACC_SCALES];
 	}
-	free(e);
 	int rc = image_write_exr(r->error_map, &m, err, errlen);
 	image_release(&m);
 	return rc;
@@ -635,13 +628,12 @@ out:
 }
 
 /*
- * One refinement pass from the analysis res.  Returns 0 when a pass ran,
- * PASS_STOP when the planner stopped the run (r->stop says why), -1 on
- * failure, POV_INTERRUPTED when a signal came.
+ * One refinement pass from the error estimate r->est.  Returns 0 when a
+ * pass ran, PASS_STOP when the planner stopped the run (r->stop says why),
+ * -1 on failure, POV_INTERRUPTED when a signal came.
  */
 enum { PASS_STOP = 2 };
-static int refine_pass(struct run *r, int pass, const struct lpr_result *res, char *err,
-		       size_t errlen)
+static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 {
 	double t = now_s(), c = self_cpu();
 	struct plan_params pp;
@@ -661,7 +653,7 @@ static int refine_pass(struct run *r, int pass, const struct lpr_result *res, ch
 		}
 	}
 	struct plan pl;
-	if (plan_make(&r->acc, res->error, res->fit, &pp, &pl, err, errlen))
+	if (plan_make_from(&r->acc, r->est, &pp, &pl, err, errlen))
 		return -1;
 	if (pl.outcome != PLAN_REFINE) {
 		r->stop = plan_outcome_name(pl.outcome);
@@ -981,7 +973,6 @@ bad:
 		goto fail_early;
 
 	r.t0 = now_s();
-	r.cpu0 = self_cpu();
 	char ident[8192];
 	if (run_identity(&r, ident, sizeof ident)) {
 		errbuf_printf(err, sizeof err, "too many POV-Ray options");
@@ -1037,6 +1028,12 @@ bad:
 	if (pov_safe_dir(r.workdir, r.povdir, sizeof r.povdir, err, sizeof err))
 		goto fail;
 
+	r.est = malloc((size_t)r.w * r.h * sizeof(*r.est));
+	if (!r.est) {
+		errbuf_printf(err, sizeof err, "out of memory");
+		goto fail;
+	}
+
 	/* refinement passes */
 	int pass = first_pass;
 	for (;;) {
@@ -1045,16 +1042,10 @@ bad:
 		if (analyse(&r, &res, err, sizeof err))
 			goto fail;
 		size_t npx = (size_t)r.w * r.h;
-		double *e = malloc(npx * sizeof(double));
-		if (!e) {
-			errbuf_printf(err, sizeof err, "out of memory");
-			goto fail;
-		}
-		double est = plan_pixel_errors(&r.acc, res.error, res.fit, e);
+		double est = plan_pixel_errors(&r.acc, res.error, res.fit, r.est);
 		long left = 0;
 		for (size_t k = 0; k < npx; k++)
-			left += e[k] > r.target;
-		free(e);
+			left += r.est[k] > r.target;
 		struct pass_rec *last = &r.passes[r.npasses - 1];
 		last->est_relmse = est;
 		last->analysis_s = now_s() - ta;
@@ -1077,7 +1068,7 @@ bad:
 			r.stop = "max passes";
 			break;
 		}
-		int rc = refine_pass(&r, pass, &res, err, sizeof err);
+		int rc = refine_pass(&r, pass, err, sizeof err);
 		if (rc == POV_INTERRUPTED) {
 			/* what finished is merged and saved: show it */
 			lpr_result_release(&res);
@@ -1141,5 +1132,6 @@ done:
 	lpr_result_release(&res);
 	image_release(&r.acc);
 	free(r.passes);
+	free(r.est);
 	return ret;
 }
