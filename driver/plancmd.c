@@ -7,6 +7,7 @@
 #include "driver/args.h"
 #include "driver/commands.h"
 #include "driver/errbuf.h"
+#include "driver/files.h"
 #include "driver/image.h"
 #include "driver/plan.h"
 #include "driver/povray.h"
@@ -105,42 +106,6 @@ static int read_analysis(const char *path, struct image *img, float **fit, float
 		(*fit)[3 * i + 1] = p[ig];
 		(*fit)[3 * i + 2] = p[ib];
 		(*press)[i] = p[ie];
-	}
-	return 0;
-}
-
-static int ensure_dir(const char *dir, char *err, size_t errlen)
-{
-	struct stat st;
-	if (mkdir(dir, 0777) && errno != EEXIST) {
-		errbuf_printf(err, errlen, "cannot create directory '%s': %s", dir, strerror(errno));
-		return -1;
-	}
-	if (stat(dir, &st) || !S_ISDIR(st.st_mode)) {
-		errbuf_printf(err, errlen, "'%s' is not a directory", dir);
-		return -1;
-	}
-	return 0;
-}
-
-/* Write text to path through a temporary file. */
-static FILE *open_tmp(const char *path, char *tmp, size_t tmplen, char *err, size_t errlen)
-{
-	snprintf(tmp, tmplen, "%s.tmp", path);
-	FILE *f = fopen(tmp, "w");
-	if (!f)
-		errbuf_printf(err, errlen, "cannot write '%s': %s", path, strerror(errno));
-	return f;
-}
-
-static int close_tmp(FILE *f, const char *tmp, const char *path, char *err, size_t errlen)
-{
-	int bad = ferror(f) != 0;
-	bad |= fclose(f) != 0;
-	if (bad || rename(tmp, path)) {
-		errbuf_printf(err, errlen, "cannot write '%s': %s", path, strerror(errno));
-		unlink(tmp);
-		return -1;
 	}
 	return 0;
 }
@@ -247,7 +212,7 @@ bad:
 		if (r2)
 			goto fail;
 	}
-	if (ensure_dir(outdir, err, sizeof err))
+	if (file_mkdirs(outdir, "directory", err, sizeof err))
 		goto fail;
 	if (plan_make(&acc, press, fit, &pp, &pl, err, sizeof err))
 		goto fail;
@@ -293,7 +258,7 @@ bad:
 	base.radiosity = radiosity;
 	base.radiosity_mode = POV_RAD_LOAD;
 	snprintf(path, sizeof path, "%s/jobs.txt", outdir);
-	FILE *f = open_tmp(path, tmp, sizeof tmp, err, sizeof err);
+	FILE *f = file_begin(path, tmp, sizeof tmp, err, sizeof err);
 	if (!f) {
 		free(jextra);
 		goto fail;
@@ -316,20 +281,24 @@ bad:
 				continue;
 			}
 		}
-		fclose(f);
-		unlink(tmp);
+		file_abort(f, tmp);
 		free(jextra);
 		goto fail;
 	}
 	free(jextra);
-	if (close_tmp(f, tmp, path, err, sizeof err))
+	if (file_commit(f, tmp, path, err, sizeof err))
 		goto fail;
 	snprintf(path, sizeof path, "%s/regions.tsv", outdir);
-	f = open_tmp(path, tmp, sizeof tmp, err, sizeof err);
+	f = file_begin(path, tmp, sizeof tmp, err, sizeof err);
 	if (!f)
 		goto fail;
-	plan_regions_write(f, &pl, pass, outs);
-	if (close_tmp(f, tmp, path, err, sizeof err))
+	if (plan_regions_write(f, &pl, pass, outs)) {
+		file_abort(f, tmp);
+		errbuf_printf(err, sizeof err, "cannot write '%s': an output path has a newline",
+			      path);
+		goto fail;
+	}
+	if (file_commit(f, tmp, path, err, sizeof err))
 		goto fail;
 	printf("%s: estimated relMSE %.6g (target %.6g)", plan_outcome_name(pl.outcome),
 	       pl.est_relmse, pp.target);

@@ -15,6 +15,7 @@
 #include "driver/args.h"
 #include "driver/commands.h"
 #include "driver/errbuf.h"
+#include "driver/files.h"
 #include "driver/image.h"
 #include "driver/plan.h"
 #include "driver/povray.h"
@@ -170,31 +171,6 @@ static double elapsed(const struct run *r)
 	return r->prev_wall + now_s() - r->t0;
 }
 
-static int mkdir_p(const char *dir, char *err, size_t errlen)
-{
-	char buf[PATH_MAX];
-	if (snprintf(buf, sizeof buf, "%s", dir) >= (int)sizeof buf) {
-		errbuf_printf(err, errlen, "work directory '%s': path too long", dir);
-		return -1;
-	}
-	for (char *p = buf + 1; *p; p++) {
-		if (*p != '/')
-			continue;
-		*p = '\0';
-		if (mkdir(buf, 0777) && errno != EEXIST) {
-			errbuf_printf(err, errlen, "cannot create '%s': %s", buf, strerror(errno));
-			return -1;
-		}
-		*p = '/';
-	}
-	if (mkdir(buf, 0777) && errno != EEXIST) {
-		errbuf_printf(err, errlen, "cannot create work directory '%s': %s", buf,
-			      strerror(errno));
-		return -1;
-	}
-	return 0;
-}
-
 /* Remove the work directory's files (ours only: nothing below it is a
  * directory but POV-Ray's link targets, which are links). */
 static void remove_workdir(const char *dir)
@@ -226,52 +202,6 @@ static int run_identity(const struct run *r, char *buf, size_t len)
 	return n > 0 && (size_t)n < len ? 0 : -1;
 }
 
-static char *slurp(const char *path)
-{
-	FILE *f = fopen(path, "r");
-	if (!f)
-		return NULL;
-	size_t cap = 4096, n = 0;
-	char *s = malloc(cap);
-	while (s) {
-		size_t k = fread(s + n, 1, cap - n - 1, f);
-		n += k;
-		if (n + 1 < cap)
-			break;
-		char *t = realloc(s, cap *= 2);
-		if (!t) {
-			free(s);
-			s = NULL;
-		} else {
-			s = t;
-		}
-	}
-	fclose(f);
-	if (s)
-		s[n] = '\0';
-	return s;
-}
-
-static int write_text_atomic(const char *path, const char *text, char *err, size_t errlen)
-{
-	char tmp[PATH_MAX + 16];
-	snprintf(tmp, sizeof tmp, "%s.tmp", path);
-	FILE *f = fopen(tmp, "w");
-	if (!f) {
-		errbuf_printf(err, errlen, "cannot write '%s': %s", tmp, strerror(errno));
-		return -1;
-	}
-	int bad = fputs(text, f) < 0;
-	bad |= fflush(f) != 0 || fsync(fileno(f)) != 0;
-	bad |= fclose(f) != 0;
-	if (bad || rename(tmp, path)) {
-		errbuf_printf(err, errlen, "cannot write '%s': %s", path, strerror(errno));
-		unlink(tmp);
-		return -1;
-	}
-	return 0;
-}
-
 /* progress.txt: the cost model, then one line per pass. */
 static int save_progress(struct run *r, char *err, size_t errlen)
 {
@@ -290,14 +220,14 @@ static int save_progress(struct run *r, char *err, size_t errlen)
 			      p->regions, p->failed, p->pixels, p->samples, p->est_relmse,
 			      p->analysis_s);
 	}
-	int rc = write_text_atomic(wpath(r, "progress.txt"), s, err, errlen);
+	int rc = file_write_text(wpath(r, "progress.txt"), s, err, errlen);
 	free(s);
 	return rc;
 }
 
 static int load_progress(struct run *r, char *err, size_t errlen)
 {
-	char *s = slurp(wpath(r, "progress.txt"));
+	char *s = file_read_text(wpath(r, "progress.txt"));
 	if (!s) {
 		errbuf_printf(err, errlen, "cannot resume: '%s' has no finished base pass",
 			      r->workdir);
@@ -464,13 +394,9 @@ static void json_str(FILE *f, const char *s)
 static int write_report(struct run *r, double est, char *err, size_t errlen)
 {
 	char tmp[PATH_MAX + 16];
-	snprintf(tmp, sizeof tmp, "%s.tmp", r->report);
-	FILE *f = fopen(tmp, "w");
-	if (!f) {
-		errbuf_printf(err, errlen, "cannot write report '%s': %s", r->report,
-			      strerror(errno));
+	FILE *f = file_begin(r->report, tmp, sizeof tmp, err, errlen);
+	if (!f)
 		return -1;
-	}
 	double tw = 0, tc = 0, td = 0, ts = 0;
 	long tp = 0;
 	int ti = 0, tf = 0;
@@ -505,15 +431,7 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 		"\"failed\": %d, \"pixels\": %ld, \"samples\": %.0f, "
 		"\"samples_per_pixel\": %.4g, \"est_relmse\": %.6g}\n}\n",
 		r->npasses, tw, tc, td, tc + td, ti, tf, tp, ts, ts / ((double)r->w * r->h), est);
-	int bad = ferror(f) != 0;
-	bad |= fclose(f) != 0;
-	if (bad || rename(tmp, r->report)) {
-		errbuf_printf(err, errlen, "cannot write report '%s': %s", r->report,
-			      strerror(errno));
-		unlink(tmp);
-		return -1;
-	}
-	return 0;
+	return file_commit(f, tmp, r->report, err, errlen);
 }
 
 /* x rounded to the nearest anchor * 2^k (geometrically). */
@@ -692,11 +610,19 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	}
 	/* what this pass renders, for inspection and for running elsewhere */
 	{
-		FILE *f = fopen(wpath(r, "regions.tsv"), "w");
-		if (f) {
-			plan_regions_write(f, &pl, pass, outs);
-			fclose(f);
+		char tmp[PATH_MAX + 16], rpath[PATH_MAX];
+		snprintf(rpath, sizeof rpath, "%s", wpath(r, "regions.tsv"));
+		FILE *f = file_begin(rpath, tmp, sizeof tmp, err, errlen);
+		if (!f)
+			goto out;
+		if (plan_regions_write(f, &pl, pass, outs)) {
+			file_abort(f, tmp);
+			errbuf_printf(err, errlen, "cannot write '%s': an output path has a newline",
+				      rpath);
+			goto out;
 		}
+		if (file_commit(f, tmp, rpath, err, errlen))
+			goto out;
 	}
 	struct pov_pool_opts po;
 	pov_pool_opts_init(&po);
@@ -980,7 +906,7 @@ bad:
 	}
 	int first_pass = 1;
 	if (r.resume) {
-		char *old = slurp(wpath(&r, "run.txt"));
+		char *old = file_read_text(wpath(&r, "run.txt"));
 		if (!old) {
 			errbuf_printf(err, sizeof err, "cannot resume: no run in work directory '%s'",
 				      r.workdir);
@@ -1005,12 +931,12 @@ bad:
 		first_pass = r.passes[r.npasses - 1].pass + 1;
 		progress(&r, "resuming after pass %d (%.1f s so far)", first_pass - 1, r.prev_wall);
 	} else {
-		if (mkdir_p(r.workdir, err, sizeof err))
+		if (file_mkdirs(r.workdir, "work directory", err, sizeof err))
 			goto fail_early;
 		/* a fresh run: forget a previous one here */
 		unlink(wpath(&r, "progress.txt"));
 		unlink(wpath(&r, "accum.exr"));
-		if (write_text_atomic(wpath(&r, "run.txt"), ident, err, sizeof err) ||
+		if (file_write_text(wpath(&r, "run.txt"), ident, err, sizeof err) ||
 		    pov_safe_dir(r.workdir, r.povdir, sizeof r.povdir, err, sizeof err))
 			goto fail;
 		int brc = base_pass(&r, err, sizeof err);
