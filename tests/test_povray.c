@@ -166,6 +166,22 @@ static const char *make_tiny_scene(char *path, size_t len, const char *dir, cons
 	return path;
 }
 
+/* job: render a tiny scene, made as name in scratch directory sub, into
+ * sub/outname at w x h; scene and out are PATH_MAX buffers for the paths. */
+static void tiny_job(struct pov_job *job, char *scene, char *out, const char *sub,
+		     const char *name, const char *outname, int w, int h)
+{
+	char dir[PATH_MAX], rel[PATH_MAX];
+
+	memset(job, 0, sizeof(*job));
+	make_tiny_scene(scene, PATH_MAX, scratch(dir, sizeof(dir), sub), name);
+	snprintf(rel, sizeof(rel), "%s/%s", sub, outname);
+	job->scene = scene;
+	job->output = scratch(out, PATH_MAX, rel);
+	job->width = w;
+	job->height = h;
+}
+
 /* A scene that takes well over 10 s at 640x480 with +AM2 +A0 +R4. */
 static const char slow_scene[] =
 	"#version 3.7;\n"
@@ -331,19 +347,15 @@ static void test_argv_order_and_quoting(void **state)
  * POV-Ray cannot be told is reached through a link. */
 static void test_argv_radiosity(void **state)
 {
-	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], work[PATH_MAX], rad[PATH_MAX],
+	char scene[PATH_MAX], out[PATH_MAX], work[PATH_MAX], rad[PATH_MAX],
 	     odd[PATH_MAX], want[PATH_MAX + 8], target[PATH_MAX], err[512];
 	struct pov_job job = { 0 };
 	char **argv;
 	int argc;
 
 	(void)state;
-	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "rad"), "s.pov");
+	tiny_job(&job, scene, out, "rad", "s.pov", "o.exr", 16, 12);
 	mkdir_p(scratch(work, sizeof(work), "rad/work"));
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "rad/o.exr");
-	job.width = 16;
-	job.height = 12;
 	job.workdir = work;
 	job.radiosity = scratch(rad, sizeof(rad), "rad/r.rca");
 	job.radiosity_mode = POV_RAD_SAVE;
@@ -439,11 +451,7 @@ static void test_argv_bad_jobs(void **state)
 	char **argv = (char **)&job;	/* must come back NULL */
 
 	(void)state;
-	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "bad"), "s.pov");
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "bad/o.exr");
-	job.width = 32;
-	job.height = 24;
+	tiny_job(&job, scene, out, "bad", "s.pov", "o.exr", 32, 24);
 
 	j = job;
 	j.scene = scratch(p, sizeof(p), "bad/missing.pov");
@@ -503,13 +511,9 @@ static void test_argv_links(void **state)
 	ssize_t n;
 
 	(void)state;
-	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "quo\"te \xc3\xa9"),
-			"sc\"ene.pov");
+	tiny_job(&job, scene, out, "quo\"te \xc3\xa9", "sc\"ene.pov", "out.exr", 16, 12);
+	scratch(dir, sizeof(dir), "quo\"te \xc3\xa9");
 	mkdir_p(scratch(work, sizeof(work), "work"));
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "quo\"te \xc3\xa9/out.exr");
-	job.width = 16;
-	job.height = 12;
 	job.workdir = work;
 	assert_int_equal(pov_argv_build(&job, &argv, NULL, err, sizeof(err)), 0);
 	/* +L, +I, +O: every path POV-Ray sees is printable ASCII without '"'
@@ -569,17 +573,13 @@ static void test_argv_links(void **state)
 
 static void test_shell_line_words(void **state)
 {
-	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512], want[PATH_MAX * 2];
+	char scene[PATH_MAX], out[PATH_MAX], err[512], want[PATH_MAX * 2];
 	static const char *const extra[] = { "+A0.1", "Antialias_Depth=3" };
 	struct pov_job job = { 0 };
 	char *line;
 
 	(void)state;
-	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "shell it's"), "s.pov");
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "shell it's/o.exr");
-	job.width = 16;
-	job.height = 12;
+	tiny_job(&job, scene, out, "shell it's", "s.pov", "o.exr", 16, 12);
 	job.extra = extra;
 	job.nextra = 2;
 	assert_int_equal(pov_shell_line(&job, &line, err, sizeof(err)), 0);
@@ -597,7 +597,7 @@ static void test_shell_line_words(void **state)
 /* The line, run by sh, gives the binary exactly the vector of pov_argv_build. */
 static void test_shell_line_round_trip_args(void **state)
 {
-	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], args[PATH_MAX], work[PATH_MAX];
+	char scene[PATH_MAX], out[PATH_MAX], args[PATH_MAX], work[PATH_MAX];
 	char err[512];
 	static const char *const extra[] = { "+A0.1", "Odd=$HOME `x` \\ ; |&", "" };
 	struct pov_job job = { 0 };
@@ -606,13 +606,8 @@ static void test_shell_line_round_trip_args(void **state)
 	size_t pos = 0;
 
 	(void)state;
-	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "rt 'q' \"d\" $x"),
-			"s c.pov");
+	tiny_job(&job, scene, out, "rt 'q' \"d\" $x", "s c.pov", "o.exr", 16, 12);
 	mkdir_p(scratch(work, sizeof(work), "work"));
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "rt 'q' \"d\" $x/o.exr");
-	job.width = 16;
-	job.height = 12;
 	job.extra = extra;
 	job.nextra = 3;
 	job.workdir = work;
@@ -639,18 +634,13 @@ static void test_shell_line_round_trip_args(void **state)
  * ".exr" (a stand-in renamed by the line's mv). */
 static void test_shell_line_renders(void **state)
 {
-	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512];
+	char scene[PATH_MAX], out[PATH_MAX], err[512];
 	struct pov_job job = { 0 };
 	struct image img = { 0 };
 	char *line;
 
 	(void)state;
-	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "sh render's dir"),
-			"the scene.pov");
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "sh render's dir/final image");
-	job.width = 24;
-	job.height = 16;
+	tiny_job(&job, scene, out, "sh render's dir", "the scene.pov", "final image", 24, 16);
 	assert_int_equal(pov_shell_line(&job, &line, err, sizeof(err)), 0);
 	assert_contains(line, " && mv -f -- ");
 	assert_int_equal(sh_c(line), 0);
@@ -812,18 +802,14 @@ static void test_pool_size(void **state)
 
 static void test_missing_binary(void **state)
 {
-	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], path[PATH_MAX], err[512];
+	char scene[PATH_MAX], out[PATH_MAX], path[PATH_MAX], err[512];
 	struct pov_job job = { 0 };
 	struct pov_result res[2];
 	struct pov_pool_opts o;
 	char *old_path = getenv("PATH") ? strdup(getenv("PATH")) : NULL;
 
 	(void)state;
-	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "nobin"), "s.pov");
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "nobin/o.exr");
-	job.width = 8;
-	job.height = 8;
+	tiny_job(&job, scene, out, "nobin", "s.pov", "o.exr", 8, 8);
 	pov_pool_opts_init(&o);
 
 	/* Not on PATH. */
@@ -940,16 +926,12 @@ static void test_pool_limit(void **state)
 
 static void test_pool_crash_retry_and_no_output(void **state)
 {
-	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX];
+	char scene[PATH_MAX], out[PATH_MAX];
 	struct pov_job job = { 0 };
 	struct pov_result res;
 
 	(void)state;
-	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "crash"), "s.pov");
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "crash/o.exr");
-	job.width = 8;
-	job.height = 8;
+	tiny_job(&job, scene, out, "crash", "s.pov", "o.exr", 8, 8);
 	job.povray = fake_bin;
 
 	setenv("FAKE_MODE", "segv", 1);
@@ -993,17 +975,13 @@ static void test_pool_error_messages(void **state)
 		{ "bad-option.txt", "Problem with option setting; Failed to parse command-line "
 				    "option", "user configuration" },
 	};
-	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], path[PATH_MAX], want[512];
+	char scene[PATH_MAX], out[PATH_MAX], path[PATH_MAX], want[512];
 	struct pov_job job = { 0 };
 	struct pov_result res;
 	size_t base;
 
 	(void)state;
-	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "msgs"), "s.pov");
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "msgs/o.exr");
-	job.width = 8;
-	job.height = 8;
+	tiny_job(&job, scene, out, "msgs", "s.pov", "o.exr", 8, 8);
 	job.povray = fake_bin;
 	setenv("FAKE_MODE", "fixture", 1);
 	assert_non_null(getcwd(path, sizeof(path) - 64));
@@ -1317,18 +1295,14 @@ static void test_sigkill_leaves_no_orphans(void **state)
  * before anything runs. */
 static void test_signal_before_pool(void **state)
 {
-	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512];
+	char scene[PATH_MAX], out[PATH_MAX], err[512];
 	struct pov_job job = { 0 };
 	struct pov_result res;
 	struct pov_pool_opts o;
 	struct sigaction before, after;
 
 	(void)state;
-	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "early"), "s.pov");
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "early/o.exr");
-	job.width = 8;
-	job.height = 8;
+	tiny_job(&job, scene, out, "early", "s.pov", "o.exr", 8, 8);
 	job.povray = fake_bin;
 	sigaction(SIGINT, NULL, &before);
 	assert_int_equal(pov_signals_catch(err, sizeof(err)), 0);
