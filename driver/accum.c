@@ -260,8 +260,15 @@ double accum_pixel_error(const struct image *acc, size_t i, double press, const 
 	 * a pixel of this brightness can plausibly be off by */
 	double e = isfinite(press) ? press / den : 1.0;
 	double n = o[ACC_SAMPLES];
-	if (n >= 4.0 && isfinite(diff))
+	if (n >= 4.0 && isfinite(diff)) {
 		e = diff;
+	} else if (n >= 4.0) {
+		/* samples from a single render (a radiosity pass): the
+		 * variance of their mean */
+		e = 0.0;
+		for (int c = 0; c < 3; c++)
+			e += o[ACC_VAR_R + c] / n / ((double)o[c] * o[c] + METRICS_RELMSE_EPS) / 3.0;
+	}
 	/* an edge or a detail between every sample position so far */
 	double edge = hidden_edge(acc, i, finest_scale(acc, i));
 	if (edge > e)
