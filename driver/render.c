@@ -789,8 +789,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	double cpu_wall = (pl.cost - (double)n * r->cost_job) / (n < (size_t)r->cores ? (double)n :
 								    r->cores);
 	double guess = rounds * r->latency > cpu_wall ? rounds * r->latency : cpu_wall;
-	progress(r, "pass %d: %zu regions, %ld pixels, %.0f samples, about %.1f s", pass, n,
-		 pl.pixels, pl.samples, guess + r->latency);
+	progress(r, "pass %d: %zu regions, %ld pixels (%ld chosen), %.0f samples, about %.1f s",
+		 pass, n, pl.pixels, pl.chosen_pixels, pl.samples, guess + r->latency);
 	int rc = pov_pool_run(jobs, n, &po, results, err, errlen);
 	if (rc < 0)
 		goto out;

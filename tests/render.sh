@@ -148,6 +148,32 @@ for name in ${RENDER_TEST_SCENES:-soft_shadows glossy_reflection thin_geometry};
 		oiiotool "$T/$name.errors.exr" --ch error,samples,order,pass -o "$T/em.exr"
 done
 
+# --- radiosity: the solution from a frame 480+ pixels wide ------------------
+# At 80x60 the radiosity pass renders 320x240 on one thread; without it the
+# region renders reuse the base pass's solution from an 80-pixel frame.  One
+# POV-Ray thread throughout: a solution computed on several is another every
+# run.
+scene="$SC/radiosity_room.pov"
+if ref=$(reference "$scene"); then
+	for mode in pass none; do
+		opt=()
+		[[ $mode == none ]] && opt=(--radiosity-scale 0)
+		"$PP" render "$scene" -o "$T/rad-$mode.exr" -W $W -H $H --target 1e-3 --max-passes 2 \
+			-q --report "$T/rad-$mode.json" "${opt[@]}" -- +WT1 || bad "radiosity ($mode): render failed"
+	done
+	with=$(relmse "$T/rad-pass.exr" "$ref")
+	without=$(relmse "$T/rad-none.exr" "$ref")
+	echo "# radiosity_room: relMSE $with with the radiosity pass, $without without"
+	check "radiosity: the report names the radiosity pass's scale (4)" \
+		grep -q '"radiosity_scale": 4' "$T/rad-pass.json"
+	check "radiosity: --radiosity-scale 0 renders no radiosity pass" \
+		grep -q '"radiosity_scale": 1' "$T/rad-none.json"
+	check "radiosity: the radiosity pass lowers the relMSE by a third or more" \
+		num 'a <= 0.67 * b' "$with" "$without"
+else
+	bad "radiosity_room: reference render failed"
+fi
+
 # --- a smooth, nearly empty scene costs almost nothing beyond the base pass --
 "$PP" render "$SC/smooth_empty.pov" -o "$T/smooth.exr" -W $W -H $H -q --report "$T/smooth.json"
 px=$(awk '/"pass": [1-9]/ { for (i = 1; i <= NF; i++) if ($i == "\"pixels\":") s += $(i + 1) }
