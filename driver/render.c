@@ -453,12 +453,12 @@ static double quantise(double x, double anchor)
 /*
  * The frame POV-Ray computes the radiosity solution on.  Its pretrace
  * places samples by fractions of the frame, and on a small frame they are
- * too coarse: on scenes/radiosity_room.pov at 160x120 a solution from a
- * 160-pixel-wide frame leaves relMSE 3.3e-3 in a render at 4x the
- * resolution, one from a 320-wide frame 2.2e-3, from 480 or 640 wide
- * 1.3e-3, from 1280 wide 1.0e-3 (README, "Radiosity").  So the solution
- * comes from the whole frame scaled by the smallest power of two that
- * makes it at least 480 pixels wide, at most 4.
+ * too coarse: on scenes/radiosity_room.pov, a 640x480 render loading a
+ * solution computed on a 160x120 frame has relMSE 2.3e-3, on 320x240
+ * 1.3e-3, on 480x360 1.1e-3, on 640x480 1.0e-3, on 1280x960 0.9e-3
+ * (scripts/radiosity_solution.sh).  So the solution comes from the whole
+ * frame scaled by the smallest power of two that makes it at least 480
+ * pixels wide, at most 4.
  */
 static int radiosity_scale(const struct run *r)
 {
@@ -492,9 +492,9 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 		errbuf_printf(err, errlen, "out of memory");
 		return -1;
 	}
-	/* one thread: POV-Ray's pretrace on several threads gives a worse
-	 * solution, and a different one every run (on radiosity_room at 640x480
-	 * relMSE 1.8e-3 to 4.1e-3 against 1.3e-3 on one thread; README) */
+	/* one thread: on several POV-Ray computes another solution every run,
+	 * some much worse (radiosity_room at 640x480: relMSE 0.8e-3 to 2.6e-3
+	 * in three runs on two threads, 1.0e-3 on one; the same script) */
 	struct pov_job job;
 	base_job(r, &job, extra, 1);
 	job.width = r->w * k;
