@@ -451,6 +451,52 @@ static double quantise(double x, double anchor)
 }
 
 /*
+ * Render the whole frame at scale k (antialiasing off, POVPRESS_PASS=0) on
+ * the given threads into out, saving the radiosity data to radfile: the
+ * base pass and the radiosity pass.  what names it in messages.  Returns 0,
+ * -1 on failure (err says why), POV_INTERRUPTED.
+ */
+static int whole_frame(struct run *r, int k, int threads, const char *out,
+		       const char *radfile, const char *what, struct pov_result *res, char *err,
+		       size_t errlen)
+{
+	const char **extra = calloc(r->nextra + 8, sizeof(char *));
+	if (!extra) {
+		errbuf_printf(err, errlen, "out of memory");
+		return -1;
+	}
+	struct pov_job job;
+	base_job(r, &job, extra, threads);
+	job.width = r->w * k;
+	job.height = r->h * k;
+	job.output = out;
+	const struct pov_define pd = { "POVPRESS_PASS", "0" };
+	job.defines = &pd;
+	job.ndefines = 1;
+	extra[job.nextra++] = "-A";
+	job.radiosity = radfile;
+	job.radiosity_mode = POV_RAD_SAVE;
+	struct pov_pool_opts po;
+	pov_pool_opts_init(&po);
+	po.max_jobs = 1;
+	po.timeout_s = r->timeout > 0 ? r->timeout : 0.0;
+	int rc = pov_pool_run(&job, 1, &po, res, err, errlen);
+	free(extra);
+	if (rc == POV_INTERRUPTED) {
+		errbuf_printf(err, errlen, "interrupted during the %s", what);
+		return POV_INTERRUPTED;
+	}
+	if (rc)
+		return -1;
+	if (res->status != POV_OK) {
+		errbuf_printf(err, errlen, "the %s of '%s' (%dx%d) failed: %s", what, r->scene,
+			      r->w * k, r->h * k, res->message);
+		return -1;
+	}
+	return 0;
+}
+
+/*
  * The frame POV-Ray computes the radiosity solution on.  Its pretrace
  * places samples by fractions of the frame, and on a small frame they are
  * too coarse: on scenes/radiosity_room.pov, a 640x480 render loading a
@@ -487,51 +533,21 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 				"%.1f s of the %.1f s budget\n", predicted, r->budget);
 		return 0;
 	}
-	const char **extra = calloc(r->nextra + 8, sizeof(char *));
-	if (!extra) {
-		errbuf_printf(err, errlen, "out of memory");
-		return -1;
-	}
-	/* one thread: on several POV-Ray computes another solution every run,
-	 * some much worse (radiosity_room at 640x480: relMSE 0.8e-3 to 2.6e-3
-	 * in three runs on two threads, 1.0e-3 on one; the same script) */
-	struct pov_job job;
-	base_job(r, &job, extra, 1);
-	job.width = r->w * k;
-	job.height = r->h * k;
 	char out[PATH_MAX], rad[PATH_MAX + 16];
 	snprintf(out, sizeof out, "%s", wpath(r, "radiosity.exr"));
 	snprintf(rad, sizeof rad, "%s/radiosity-new.rca", r->workdir);
-	job.output = out;
-	const struct pov_define pd = { "POVPRESS_PASS", "0" };
-	job.defines = &pd;
-	job.ndefines = 1;
-	extra[job.nextra++] = "-A";
-	job.radiosity = rad;
-	job.radiosity_mode = POV_RAD_SAVE;
-	struct pov_pool_opts po;
-	pov_pool_opts_init(&po);
-	po.max_jobs = 1;
-	po.timeout_s = r->timeout > 0 ? r->timeout : 0.0;
 	struct pov_result res = {0};
+	struct image img = {0}, acc = {0};
 	double t = now_s();
 	progress(r, "radiosity pass: %dx%d (%d x %d samples per pixel) for the radiosity "
 		 "solution", r->w * k, r->h * k, k, k);
-	int rc = pov_pool_run(&job, 1, &po, &res, err, errlen);
-	int ret = -1;
-	struct image img = {0}, acc = {0};
-	if (rc == POV_INTERRUPTED) {
-		errbuf_printf(err, errlen, "interrupted during the radiosity pass");
-		ret = POV_INTERRUPTED;
+	/* one thread: on several POV-Ray computes another solution every run,
+	 * some much worse (radiosity_room at 640x480: relMSE 0.8e-3 to 2.6e-3
+	 * in three runs on two threads, 1.0e-3 on one; the same script) */
+	int ret = whole_frame(r, k, 1, out, rad, "radiosity pass", &res, err, errlen);
+	if (ret)
 		goto out;
-	}
-	if (rc)
-		goto out;
-	if (res.status != POV_OK) {
-		errbuf_printf(err, errlen, "the radiosity pass of '%s' (%dx%d) failed: %s",
-			      r->scene, r->w * k, r->h * k, res.message);
-		goto out;
-	}
+	ret = -1;
 	if (image_read_exr(out, &img, err, errlen) ||
 	    image_init(&acc, r->w, r->h, ACC_NCH, accum_names, err, errlen))
 		goto out;
@@ -568,56 +584,27 @@ out:
 	image_release(&img);
 	unlink(out);
 	pov_result_release(&res);
-	free(extra);
 	return ret;
 }
 
 /* The base pass: the whole image, one sample per pixel. */
 static int base_pass(struct run *r, char *err, size_t errlen)
 {
-	const char **extra = calloc(r->nextra + 8, sizeof(char *));
-	if (!extra) {
-		errbuf_printf(err, errlen, "out of memory");
-		return -1;
-	}
-	struct pov_job job;
-	base_job(r, &job, extra, r->cores);
 	char out[PATH_MAX];
 	snprintf(out, sizeof out, "%s", wpath(r, "base.exr"));
-	job.output = out;
-	const struct pov_define pd = { "POVPRESS_PASS", "0" };
-	job.defines = &pd;
-	job.ndefines = 1;
-	/* antialiasing off: the base pass is one sample at each pixel centre;
-	 * radiosity, if the scene has any, is saved for the region renders */
-	extra[job.nextra++] = "-A";
-	job.radiosity = r->radfile;
-	job.radiosity_mode = POV_RAD_SAVE;
-	struct pov_pool_opts po;
-	pov_pool_opts_init(&po);
-	po.max_jobs = 1;
-	po.timeout_s = r->timeout > 0 ? r->timeout : 0.0;
 	struct pov_result res = {0};
 	double t = now_s(), c = self_cpu();
 	progress(r, "base pass: %dx%d, 1 sample per pixel", r->w, r->h);
-	int rc = pov_pool_run(&job, 1, &po, &res, err, errlen);
-	int ret = -1;
-	if (rc == POV_INTERRUPTED) {
-		errbuf_printf(err, errlen, "interrupted during the base pass");
-		ret = POV_INTERRUPTED;
+	/* one sample at each pixel centre; radiosity, if the scene has any, is
+	 * saved for the region renders */
+	int ret = whole_frame(r, 1, r->cores, out, r->radfile, "base pass", &res, err, errlen);
+	if (ret)
 		goto out;
-	}
-	if (rc)
-		goto out;
-	if (res.status != POV_OK) {
-		errbuf_printf(err, errlen, "the base pass of '%s' failed: %s", r->scene,
-			      res.message);
-		goto out;
-	}
+	ret = -1;
 	struct image img = {0};
 	if (image_read_exr(out, &img, err, errlen))
 		goto out;
-	rc = accum_from_base(&img, out, &r->acc, err, errlen);
+	int rc = accum_from_base(&img, out, &r->acc, err, errlen);
 	image_release(&img);
 	if (rc)
 		goto out;
@@ -682,7 +669,6 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	ret = 0;
 out:
 	pov_result_release(&res);
-	free(extra);
 	return ret;
 }
 
