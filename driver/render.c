@@ -521,13 +521,13 @@ static int radiosity_scale(const struct run *r)
  * frame at scale k on one thread, antialiasing off, saving its radiosity
  * solution for the region renders.  Its k x k samples per pixel replace the base pass's
  * one (which was shaded with the coarser solution).  Returns 0 when done
- * or skipped (the budget cannot afford it), -1 on failure,
+ * or skipped (it would not end within the budget), -1 on failure,
  * POV_INTERRUPTED.
  */
 static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, size_t errlen)
 {
 	double predicted = r->latency + r->cost_sample * k * k * (double)r->w * r->h;
-	if (r->budget > 0.0 && elapsed(r) + predicted > 0.5 * r->budget) {
+	if (r->budget > 0.0 && elapsed(r) + predicted > r->budget) {
 		if (r->verbose)
 			fprintf(stderr, "povpress render: no radiosity pass: it would take about "
 				"%.1f s of the %.1f s budget\n", predicted, r->budget);
