@@ -89,6 +89,11 @@ done
 check "render without a scene is a usage error (2)" test $? -eq 2
 "$PP" render "$SC/smooth_empty.pov" -o "$T/x.exr" --target nope 2>/dev/null
 check "render with a bad --target is a usage error (2)" test $? -eq 2
+msg=$("$PP" render "$SC/smooth_empty.pov" -o "$T/x.exr" --radiosity-scale 3 2>&1)
+rc=$?
+check "render with --radiosity-scale 3 (not 0, 1, 2, 4 or 8) is a usage error (2)" \
+	test $rc -eq 2
+check "... whose message names the option" grep -q -- "--radiosity-scale" <<<"$msg"
 
 # --- bad input: a clear message, non-zero, no output --------------------------
 fault() { # fault DESCRIPTION PATTERN OUTPUT COMMAND...: fails, says PATTERN, no OUTPUT
