@@ -173,8 +173,10 @@ if ref=$(reference "$scene"); then
 		grep -q '"radiosity_scale": 4' "$T/rad-pass.json"
 	check "radiosity: --radiosity-scale 0 renders no radiosity pass" \
 		grep -q '"radiosity_scale": 1' "$T/rad-none.json"
-	check "radiosity: the radiosity pass lowers the relMSE by a third or more" \
-		num 'a <= 0.67 * b' "$with" "$without"
+	# (0.48 against the reference cached here, 0.58 against a fresh one: the
+	# reference's own radiosity solution differs from render to render)
+	check "radiosity: the radiosity pass lowers the relMSE by a fifth or more" \
+		num 'a <= 0.8 * b' "$with" "$without"
 else
 	bad "radiosity_room: reference render failed"
 fi
