@@ -193,6 +193,19 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 	return 0;
 }
 
+int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
+		     int y1, int pass, long *folded, char *err, size_t errlen)
+{
+	struct image img = {0};
+	int oy = 0;
+	if (folded)
+		*folded = 0;
+	int rc = image_read_exr_rows(path, y0 * s, (y1 + 1) * s - 1, &img, &oy, err, errlen) ||
+		 accum_merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, folded, err, errlen);
+	image_release(&img);
+	return rc ? -1 : 0;
+}
+
 /* The finest scale pixel i has been sampled at. */
 static int finest_scale(const struct image *acc, size_t i)
 {
@@ -247,8 +260,7 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 	return isfinite(best) ? best : 1.0;
 }
 
-double accum_pixel_error(const struct image *acc, size_t i, double press, const float fit[3],
-			 double diff)
+double accum_error_scale(const struct image *acc, size_t i, const float fit[3])
 {
 	const float *o = acc->px + i * ACC_NCH;
 	double den = 0.0;
@@ -256,6 +268,14 @@ double accum_pixel_error(const struct image *acc, size_t i, double press, const 
 		double f = isfinite(fit[c]) ? fit[c] : o[c];
 		den += (f * f + METRICS_RELMSE_EPS) / 3.0;
 	}
+	return den;
+}
+
+double accum_pixel_error(const struct image *acc, size_t i, double press, const float fit[3],
+			 double diff)
+{
+	const float *o = acc->px + i * ACC_NCH;
+	double den = accum_error_scale(acc, i, fit);
 	/* no estimate (a hole the regression could not reach): assume the worst
 	 * a pixel of this brightness can plausibly be off by */
 	double e = isfinite(press) ? press / den : 1.0;

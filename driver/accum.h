@@ -84,6 +84,16 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 		       int y0, int x1, int y1, int pass, long *folded, char *err,
 		       size_t errlen);
 
+/* The same from the render's file at path, reading only the rows the
+ * rectangle needs. */
+int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
+		     int y1, int pass, long *folded, char *err, size_t errlen);
+
+/* What pixel i's relative errors are relative to: the mean over R, G, B
+ * of value^2 + 0.01, the value being fit (the regression's, where finite)
+ * or else the samples' mean. */
+double accum_error_scale(const struct image *acc, size_t i, const float fit[3]);
+
 /*
  * The estimated relative squared error of pixel i's mean (a term of
  * relMSE: squared error over value^2 + 0.01; 1 when unknown), the largest

@@ -4,8 +4,10 @@
 #include "driver/plan.h"
 #include "driver/accum.h"
 #include "driver/errbuf.h"
+#include "driver/files.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -503,6 +505,26 @@ int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *ou
 			r->scale, outputs[k]);
 	}
 	return ferror(f) ? -1 : 0;
+}
+
+void plan_output_name(char *buf, size_t len, const char *dir, int pass, size_t k, int scale)
+{
+	snprintf(buf, len, "%s/p%02d-r%03zu-s%d.exr", dir, pass, k, scale);
+}
+
+int plan_regions_save(const char *path, const struct plan *pl, int pass, char *const *outputs,
+		      char *err, size_t errlen)
+{
+	char tmp[PATH_MAX + 16];
+	FILE *f = file_begin(path, tmp, sizeof tmp, err, errlen);
+	if (!f)
+		return -1;
+	if (plan_regions_write(f, pl, pass, outputs)) {
+		file_abort(f, tmp);
+		errbuf_printf(err, errlen, "cannot write '%s': an output path has a newline", path);
+		return -1;
+	}
+	return file_commit(f, tmp, path, err, errlen);
 }
 
 int plan_regions_read(const char *path, struct plan_region **regions, char ***outputs,

@@ -110,6 +110,12 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
  * free() it and *outputs, an array of strings each to free()).
  */
 int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *outputs);
+/* The image region k of a pass renders to: DIR/pPP-rKKK-sS.exr. */
+void plan_output_name(char *buf, size_t len, const char *dir, int pass, size_t k, int scale);
+
+/* plan_regions_write() to path, through a temporary file. */
+int plan_regions_save(const char *path, const struct plan *pl, int pass, char *const *outputs,
+		      char *err, size_t errlen);
 int plan_regions_read(const char *path, struct plan_region **regions, char ***outputs,
 		      int **passes, size_t *n, char *err, size_t errlen);
 

@@ -265,8 +265,7 @@ bad:
 	}
 	for (size_t k = 0; k < pl.nregions; k++) {
 		char name[PATH_MAX];
-		snprintf(name, sizeof name, "%s/p%02d-r%03zu-s%d.exr", outdir, pass, k,
-			 pl.regions[k].scale);
+		plan_output_name(name, sizeof name, outdir, pass, k, pl.regions[k].scale);
 		outs[k] = strdup(name);
 		struct pov_region reg;
 		struct pov_job job;
@@ -289,16 +288,7 @@ bad:
 	if (file_commit(f, tmp, path, err, sizeof err))
 		goto fail;
 	snprintf(path, sizeof path, "%s/regions.tsv", outdir);
-	f = file_begin(path, tmp, sizeof tmp, err, sizeof err);
-	if (!f)
-		goto fail;
-	if (plan_regions_write(f, &pl, pass, outs)) {
-		file_abort(f, tmp);
-		errbuf_printf(err, sizeof err, "cannot write '%s': an output path has a newline",
-			      path);
-		goto fail;
-	}
-	if (file_commit(f, tmp, path, err, sizeof err))
+	if (plan_regions_save(path, &pl, pass, outs, err, sizeof err))
 		goto fail;
 	printf("%s: estimated relMSE %.6g (target %.6g)", plan_outcome_name(pl.outcome),
 	       pl.est_relmse, pp.target);
@@ -385,7 +375,6 @@ int cmd_merge(int argc, char **argv)
 	int missing = 0;
 	for (size_t k = 0; k < n; k++) {
 		const struct plan_region *g = &regs[k];
-		int s = g->scale, oy = 0;
 		long folded = 0;
 		char why[900];
 		if (access(outs[k], F_OK) && skip) {
@@ -394,15 +383,12 @@ int cmd_merge(int argc, char **argv)
 			missing++;
 			continue;
 		}
-		if (image_read_exr_rows(outs[k], g->y0 * s, (g->y1 + 1) * s - 1, &img, &oy, why,
-					sizeof why) ||
-		    accum_merge_region(&acc, &img, oy, s, g->x0, g->y0, g->x1, g->y1, passes[k],
-				       &folded, why, sizeof why)) {
+		if (accum_merge_file(&acc, outs[k], g->scale, g->x0, g->y0, g->x1, g->y1,
+				     passes[k], &folded, why, sizeof why)) {
 			errbuf_printf(err, sizeof err, "region %zu of '%s' (%s): %s", k + 1, regp,
 				      outs[k], why);
 			goto fail;
 		}
-		image_release(&img);
 		total += folded;
 	}
 	if (image_write_exr(outp, &acc, err, sizeof err))

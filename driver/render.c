@@ -119,7 +119,8 @@ struct run {
 	/* options */
 	const char *scene, *out, *workdir, *error_map, *report;
 	char povdir[PATH_MAX];	/* workdir as POV-Ray can be told it */
-	char radfile[PATH_MAX + 16];	/* the base pass's radiosity data, in workdir */
+	char radfile[PATH_MAX + 16];	/* the radiosity data region renders load (from
+					 * the radiosity pass, else the base pass) */
 	int w, h, max_passes, jobs, quiet, verbose, keep, resume, user_workdir;
 	double target, budget, timeout;
 	double user_cost_job, user_cost_sample;	/* 0: measure */
@@ -211,6 +212,16 @@ static int run_identity(const struct run *r, char *buf, size_t len)
 	return n > 0 && (size_t)n < len ? 0 : -1;
 }
 
+static int add_pass(struct run *r, const struct pass_rec *p)
+{
+	void *q = realloc(r->passes, (r->npasses + 1) * sizeof(*r->passes));
+	if (!q)
+		return -1;
+	r->passes = q;
+	r->passes[r->npasses++] = *p;
+	return 0;
+}
+
 /* progress.txt: the cost model, then one line per pass. */
 static int save_progress(struct run *r, char *err, size_t errlen)
 {
@@ -254,11 +265,8 @@ static int load_progress(struct run *r, char *err, size_t errlen)
 		if (sscanf(line, "pass %d %lf %lf %lf %d %d %d %ld %lf %lf %lf", &p.pass, &p.wall_s,
 			   &p.cpu_s, &p.driver_cpu_s, &p.invocations, &p.regions, &p.failed,
 			   &p.pixels, &p.samples, &p.est_relmse, &p.analysis_s) == 11) {
-			void *q = realloc(r->passes, (r->npasses + 1) * sizeof(*r->passes));
-			if (!q)
+			if (add_pass(r, &p))
 				break;
-			r->passes = q;
-			r->passes[r->npasses++] = p;
 			ok |= 2;
 		}
 	}
@@ -269,16 +277,6 @@ static int load_progress(struct run *r, char *err, size_t errlen)
 	}
 	for (size_t k = 0; k < r->npasses; k++)
 		r->prev_wall += r->passes[k].wall_s;
-	return 0;
-}
-
-static int add_pass(struct run *r, const struct pass_rec *p)
-{
-	void *q = realloc(r->passes, (r->npasses + 1) * sizeof(*r->passes));
-	if (!q)
-		return -1;
-	r->passes = q;
-	r->passes[r->npasses++] = *p;
 	return 0;
 }
 
@@ -367,12 +365,7 @@ static int write_error_map(struct run *r, const struct lpr_result *res, char *er
 	for (size_t i = 0; i < npx; i++) {
 		const float *o = r->acc.px + i * ACC_NCH;
 		float *q = m.px + i * 7;
-		double den = 0.0;
-		for (int c = 0; c < 3; c++) {
-			double f = res->fit[3 * i + c];
-			den += (isfinite(f) ? f * f : 0.0) + 0.01;
-		}
-		q[0] = (float)(e[i] * den / 3.0);
+		q[0] = (float)(e[i] * accum_error_scale(&r->acc, i, res->fit + 3 * i));
 		q[1] = (float)e[i];
 		q[2] = o[ACC_SAMPLES];
 		q[3] = res->order[i];
@@ -646,8 +639,9 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	p.regions = 1;
 	p.pixels = (long)r->w * r->h;
 	p.samples = (double)r->w * r->h;
-	p.driver_cpu_s = self_cpu() - c;
 	p.est_relmse = NAN;	/* filled in by the first analysis */
+	/* at scale 1 the radiosity pass only repeats a base pass that ran on
+	 * several threads */
 	int k = r->radiosity ? radiosity_scale(r) : 0;
 	if (k > 1 || (k == 1 && r->cores > 1)) {
 		int rrc = radiosity_pass(r, k, &p, err, errlen);
@@ -725,9 +719,9 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	base.defines = &pd;
 	base.ndefines = 1;
 	for (size_t k = 0; k < n; k++) {
-		char name[64];
-		snprintf(name, sizeof name, "p%02d-r%03zu-s%d.exr", pass, k, pl.regions[k].scale);
-		outs[k] = strdup(wpath(r, name));
+		char name[PATH_MAX];
+		plan_output_name(name, sizeof name, r->workdir, pass, k, pl.regions[k].scale);
+		outs[k] = strdup(name);
 		if (!outs[k]) {
 			errbuf_printf(err, errlen, "out of memory");
 			goto out;
@@ -736,21 +730,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			 &jobs[k]);
 	}
 	/* what this pass renders, for inspection and for running elsewhere */
-	{
-		char tmp[PATH_MAX + 16], rpath[PATH_MAX];
-		snprintf(rpath, sizeof rpath, "%s", wpath(r, "regions.tsv"));
-		FILE *f = file_begin(rpath, tmp, sizeof tmp, err, errlen);
-		if (!f)
-			goto out;
-		if (plan_regions_write(f, &pl, pass, outs)) {
-			file_abort(f, tmp);
-			errbuf_printf(err, errlen, "cannot write '%s': an output path has a newline",
-				      rpath);
-			goto out;
-		}
-		if (file_commit(f, tmp, rpath, err, errlen))
-			goto out;
-	}
+	if (plan_regions_save(wpath(r, "regions.tsv"), &pl, pass, outs, err, errlen))
+		goto out;
 	struct pov_pool_opts po;
 	pov_pool_opts_init(&po);
 	po.max_jobs = r->jobs < (int)n ? r->jobs : (int)n;
@@ -796,21 +777,15 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			}
 			continue;
 		}
-		struct image img = {0};
-		int oy = 0;
 		long folded = 0;
 		int s = g->scale;
-		if (image_read_exr_rows(outs[k], g->y0 * s, (g->y1 + 1) * s - 1, &img, &oy, err,
-					errlen) ||
-		    accum_merge_region(&r->acc, &img, oy, s, g->x0, g->y0, g->x1, g->y1, pass,
-				       &folded, err, errlen)) {
+		if (accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1, pass,
+				     &folded, err, errlen)) {
 			fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n", pass,
 				g->x0, g->y0, g->x1, g->y1, err);
 			p.failed++;
-			image_release(&img);
 			continue;
 		}
-		image_release(&img);
 		p.regions++;
 		p.pixels += folded;
 		p.samples += (double)folded * s * s;

@@ -537,6 +537,16 @@ static void check_regions(const struct plan *pl, const struct plan_params *p)
 	assert_true(pl->samples == 4.0 * (double)inside);
 }
 
+/* plan_make() on the input, which must succeed: the plan's outcome. */
+static enum plan_outcome plan_of(struct plan_input *in, const struct plan_params *p,
+				 struct plan *pl)
+{
+	char err[256];
+
+	assert_int_equal(plan_make(&in->acc, in->press, in->fit, p, pl, err, sizeof(err)), 0);
+	return pl->outcome;
+}
+
 /* 6. plan_make: refine, target met, no budget, packing, no gain. */
 static void test_plan_make(void **state)
 {
@@ -545,14 +555,12 @@ static void test_plan_make(void **state)
 	struct plan_input *in = malloc(sizeof(*in));
 	struct plan_params p;
 	struct plan pl;
-	char err[256];
 
 	(void)state;
 	assert_non_null(in);
 	plan_params_init(&p);
 	plan_input(in, block, 1, 1.0f);
-	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
-	assert_int_equal(pl.outcome, PLAN_REFINE);
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
 	assert_int_equal(pl.chosen_pixels, 30);
 	for (int y = 0; y < PH; y++)
 		for (int x = 0; x < PW; x++) {
@@ -574,8 +582,7 @@ static void test_plan_make(void **state)
 
 	/* nothing to fix */
 	plan_input(in, block, 0, 0.0f);
-	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
-	assert_int_equal(pl.outcome, PLAN_TARGET_MET);
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_TARGET_MET);
 	assert_int_equal(pl.nregions, 0);
 	plan_release(&pl);
 	image_release(&in->acc);
@@ -583,8 +590,7 @@ static void test_plan_make(void **state)
 	/* a budget below one pixel's 4 samples */
 	plan_input(in, block, 1, 1.0f);
 	p.budget = 0.5 * 4 * p.cost_sample;
-	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
-	assert_int_equal(pl.outcome, PLAN_NO_BUDGET);
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_NO_BUDGET);
 	assert_int_equal(pl.nregions, 0);
 	plan_release(&pl);
 	p.budget = 0.0;
@@ -593,8 +599,7 @@ static void test_plan_make(void **state)
 	/* two distant blocks: one render when a job is dear, two when free */
 	plan_input(in, two, 2, 1.0f);
 	p.cost_job = 1e3;
-	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
-	assert_int_equal(pl.outcome, PLAN_REFINE);
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
 	assert_int_equal(pl.nregions, 1);
 	assert_true(pl.regions[0].x0 <= 2 && pl.regions[0].y0 <= 2 && pl.regions[0].x1 >= 61 &&
 		    pl.regions[0].y1 >= 43);
@@ -603,8 +608,7 @@ static void test_plan_make(void **state)
 	plan_release(&pl);
 
 	p.cost_job = 0.0;
-	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
-	assert_int_equal(pl.outcome, PLAN_REFINE);
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
 	assert_int_equal(pl.nregions, 2);
 	for (int b = 0; b < 2; b++) {
 		int hits = 0;
@@ -620,8 +624,7 @@ static void test_plan_make(void **state)
 
 	/* ... and a cap of one region forces the merge */
 	p.max_regions = 1;
-	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
-	assert_int_equal(pl.outcome, PLAN_REFINE);
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
 	assert_int_equal(pl.nregions, 1);
 	check_regions(&pl, &p);
 	assert_int_equal(pl.chosen_pixels, 9 + 16);
@@ -635,7 +638,7 @@ static void test_plan_make(void **state)
 		in->press[i] = 1.0f;
 		accpx(&in->acc, (size_t)i)[ACC_SCALES] = 2.0f + 4 + 16 + 256 + 65536;
 	}
-	assert_int_equal(plan_make(&in->acc, in->press, in->fit, &p, &pl, err, sizeof(err)), 0);
+	plan_of(in, &p, &pl);
 	assert_true(pl.est_relmse > p.target);
 	assert_int_equal(pl.outcome, PLAN_NO_GAIN);
 	assert_int_equal(pl.nregions, 0);
