@@ -121,14 +121,123 @@ int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
 	return 0;
 }
 
-int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
-		       int y0, int x1, int y1, int pass, long *folded, char *err,
-		       size_t errlen)
+/*
+ * Add pixel i's terms to w for new samples of mean mean[3] (see
+ * struct accum_worth): its relative sample variance A_i and the relative
+ * squared difference D_i between the new mean and its mean.  A pixel
+ * without two samples, or that already has scale s, does not count.
+ */
+static void worth_add(const struct image *acc, size_t i, int s, const double mean[3],
+		      struct accum_worth *w)
 {
+	const float *o = acc->px + i * ACC_NCH;
+	if (!(o[ACC_SAMPLES] >= 2.0f) || accum_has_scale(acc, i, s))
+		return;
+	double a = 0.0, d = 0.0;
+	for (int c = 0; c < 3; c++) {
+		double den = (double)o[c] * o[c] + METRICS_RELMSE_EPS;
+		double e = mean[c] - o[c];
+		a += o[ACC_VAR_R + c] / den / 3.0;
+		d += e * e / den / 3.0;
+	}
+	if (!isfinite(a) || !isfinite(d))
+		return;
+	w->a += a;
+	w->d += d;
+	w->pixels++;
+}
+
+double accum_worth_samples(const struct accum_worth *w)
+{
+	if (!(w->a > 0.0))
+		return 0.0;
+	if (w->d * ACC_AA_MAX <= w->a)
+		return ACC_AA_MAX;	/* also d == 0 */
+	return w->a / w->d < 1.0 ? 1.0 : w->a / w->d;
+}
+
+/* The worth of an antialiased render of a region (accum_worth_samples()),
+ * rounded, and its sums into w. */
+static int aa_worth(const struct image *acc, const struct image *img, int oy, const int ch[3],
+		    int x0, int y0, int x1, int y1, struct accum_worth *w)
+{
+	for (int y = y0; y <= y1; y++)
+		for (int x = x0; x <= x1; x++) {
+			const float *p = img->px + ((size_t)(y - oy) * img->w + x) * img->nch;
+			double mean[3] = { p[ch[0]], p[ch[1]], p[ch[2]] };
+			worth_add(acc, (size_t)y * acc->w + x, ACC_AA, mean, w);
+		}
+	return (int)lround(accum_worth_samples(w));
+}
+
+/* Fold an antialiased render at scale 1 (see aa_worth()). */
+static long merge_aa(struct image *acc, const struct image *img, int oy, const int ch[3],
+		     int x0, int y0, int x1, int y1, int pass, struct accum_worth *w)
+{
+	int n = aa_worth(acc, img, oy, ch, x0, y0, x1, y1, w);
+	long count = 0;
+	for (int y = y0; y <= y1; y++)
+		for (int x = x0; x <= x1; x++) {
+			size_t i = (size_t)y * acc->w + x;
+			const float *o = acc->px + i * ACC_NCH;
+			const float *p = img->px + ((size_t)(y - oy) * img->w + x) * img->nch;
+			double mean[3], m2[3];
+			int ok = 1;
+			for (int c = 0; c < 3; c++) {
+				mean[c] = p[ch[c]];
+				ok &= isfinite(mean[c]) != 0;
+			}
+			/* the render's samples spread as the pixel's do; a pixel
+			 * with no spread to weigh it by takes it as one sample,
+			 * and none takes it as more than its own a / d (a bias
+			 * where the pixel's spread is small would be weighted as
+			 * the region's noisier pixels prove it worth) */
+			int k = !ok ? 0 : n >= 1 && o[ACC_SAMPLES] >= 2.0f ? n : 1;
+			if (k > 1) {
+				struct accum_worth one = {0};
+				worth_add(acc, i, ACC_AA, mean, &one);
+				double own = accum_worth_samples(&one);
+				if (own < k)
+					k = own >= 1.0 ? (int)lround(own) : 1;
+			}
+			for (int c = 0; c < 3; c++)
+				m2[c] = k > 1 ? (double)o[ACC_VAR_R + c] * (k - 1) : 0.0;
+			double na = o[ACC_SAMPLES], prev = o[ACC_DIFF], d = 0.0;
+			if (accum_fold(acc, i, ACC_AA, k, mean, m2, pass) || !k)
+				continue;
+			count++;
+			if (!(na > 0.0))
+				continue;
+			/* the error of the new mean, not knowing which of the two
+			 * the difference d between them belongs to (the render
+			 * holds POV-Ray's antialiasing bias: its threshold test
+			 * and area-light patterns converge to their own answer;
+			 * the old mean can hold a sample grid's aliasing): each
+			 * one's weight squared times d, or for the old mean its
+			 * own error if larger */
+			double wa = na / (na + k), wb = k / (na + k);
+			for (int c = 0; c < 3; c++) {
+				double e = mean[c] - (o[c] - wb * mean[c]) / wa;
+				d += e * e / ((double)o[c] * o[c] + METRICS_RELMSE_EPS) / 3.0;
+			}
+			double em = isfinite(prev) && prev > d ? prev : d;
+			acc->px[i * ACC_NCH + ACC_DIFF] = (float)(wb * wb * d + wa * wa * em);
+		}
+	return count;
+}
+
+static int merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
+			int y0, int x1, int y1, int pass, long *folded, struct accum_worth *w,
+			char *err, size_t errlen)
+{
+	struct accum_worth scratch = {0};
+	if (!w)
+		w = &scratch;
 	if (folded)
 		*folded = 0;
-	if (s < 1 || s > 16 || (s & (s - 1)) != 0) {
-		errbuf_printf(err, errlen, "scale %d is not one of 1, 2, 4, 8, 16", s);
+	if (s != ACC_AA && (s < 1 || s > 16 || (s & (s - 1)) != 0)) {
+		errbuf_printf(err, errlen, "scale %d is not one of 0 (antialiased), 1, 2, 4, 8, 16",
+			      s);
 		return -1;
 	}
 	if (x0 < 0 || y0 < 0 || x1 >= acc->w || y1 >= acc->h || x0 > x1 || y0 > y1) {
@@ -136,14 +245,15 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 			      y0, x1, y1, acc->w, acc->h);
 		return -1;
 	}
-	if (img->w != acc->w * s) {
+	const int f = s == ACC_AA ? 1 : s;	/* the render's size over acc's */
+	if (img->w != acc->w * f) {
 		errbuf_printf(err, errlen, "the render is %d pixels wide, not %d (%d x %d)", img->w,
-			      acc->w * s, acc->w, s);
+			      acc->w * f, acc->w, f);
 		return -1;
 	}
-	if (oy > y0 * s || oy + img->h < (y1 + 1) * s) {
-		errbuf_printf(err, errlen, "the render lacks rows %d..%d", y0 * s,
-			      (y1 + 1) * s - 1);
+	if (oy > y0 * f || oy + img->h < (y1 + 1) * f) {
+		errbuf_printf(err, errlen, "the render lacks rows %d..%d", y0 * f,
+			      (y1 + 1) * f - 1);
 		return -1;
 	}
 	int ir = image_channel(img, "R"), ig = image_channel(img, "G"),
@@ -153,6 +263,12 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 		return -1;
 	}
 	const int ch[3] = { ir, ig, ib };
+	if (s == ACC_AA) {
+		long c = merge_aa(acc, img, oy, ch, x0, y0, x1, y1, pass, w);
+		if (folded)
+			*folded = c;
+		return 0;
+	}
 	long count = 0;
 	for (int y = y0; y <= y1; y++) {
 		for (int x = x0; x <= x1; x++) {
@@ -184,6 +300,8 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 						mean[c] = n ? sum[c] / n : 0.0;
 			}
 			size_t i = (size_t)y * acc->w + x;
+			if (n)
+				worth_add(acc, i, s, mean, w);
 			if (!accum_fold(acc, i, s, n, mean, m2, pass) && n)
 				count++;
 		}
@@ -193,26 +311,38 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 	return 0;
 }
 
+int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
+		       int y0, int x1, int y1, int pass, long *folded, char *err,
+		       size_t errlen)
+{
+	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, folded, NULL, err, errlen);
+}
+
 int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
-		     int y1, int pass, long *folded, char *err, size_t errlen)
+		     int y1, int pass, long *folded, struct accum_worth *worth, char *err,
+		     size_t errlen)
 {
 	struct image img = {0};
 	int oy = 0;
 	if (folded)
 		*folded = 0;
-	int rc = image_read_exr_rows(path, y0 * s, (y1 + 1) * s - 1, &img, &oy, err, errlen) ||
-		 accum_merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, folded, err, errlen);
+	const int k = s == ACC_AA ? 1 : s;
+	int rc = image_read_exr_rows(path, y0 * k, (y1 + 1) * k - 1, &img, &oy, err, errlen) ||
+		 merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, folded, worth, err, errlen);
 	image_release(&img);
 	return rc ? -1 : 0;
 }
 
-/* The finest scale pixel i has been sampled at. */
+/* The finest scale pixel i has been sampled at; an antialiased render
+ * (which subdivides to 1/16 of a pixel where corners differ) counts as 8. */
 static int finest_scale(const struct image *acc, size_t i)
 {
 	int best = 1;
 	for (int k = 0; k < ACC_NSCALES; k++)
 		if (accum_has_scale(acc, i, accum_scales[k]))
 			best = accum_scales[k];
+	if (accum_has_scale(acc, i, ACC_AA) && best < 8)
+		best = 8;
 	return best;
 }
 
@@ -290,7 +420,8 @@ double accum_pixel_error(const struct image *acc, size_t i, double press, const 
 			e += o[ACC_VAR_R + c] / n / ((double)o[c] * o[c] + METRICS_RELMSE_EPS) / 3.0;
 	}
 	/* an edge or a detail between every sample position so far */
-	double edge = hidden_edge(acc, i, finest_scale(acc, i));
+	int fs = finest_scale(acc, i);
+	double edge = fs < ACC_EDGE_SCALE ? hidden_edge(acc, i, fs) : 0.0;
 	if (edge > e)
 		e = edge;
 	if (n <= 0.0)
@@ -338,4 +469,73 @@ long accum_final_image(const struct image *acc, const float *fit, const float *p
 		took += use_fit;
 	}
 	return took;
+}
+
+/* The mean of pixel (x, y)'s s x s block of img (rows from oy) in mean[3];
+ * 0 when a sample is not finite. */
+static int block_mean(const struct image *img, int oy, const int ch[3], int s, int x, int y,
+		      double mean[3])
+{
+	mean[0] = mean[1] = mean[2] = 0.0;
+	for (int j = 0; j < s; j++)
+		for (int k = 0; k < s; k++) {
+			const float *p = img->px +
+				((size_t)(y * s + j - oy) * img->w + (size_t)x * s + k) * img->nch;
+			for (int c = 0; c < 3; c++) {
+				if (!isfinite(p[ch[c]]))
+					return 0;
+				mean[c] += p[ch[c]] / ((double)s * s);
+			}
+		}
+	return 1;
+}
+
+static int rgb_of(const struct image *img, const char *path, int ch[3], char *err, size_t errlen)
+{
+	ch[0] = image_channel(img, "R");
+	ch[1] = image_channel(img, "G");
+	ch[2] = image_channel(img, "B");
+	if (ch[0] < 0 || ch[1] < 0 || ch[2] < 0) {
+		errbuf_printf(err, errlen, "'%s' has no R, G and B channels", path);
+		return -1;
+	}
+	return 0;
+}
+
+int accum_pair_files(const struct image *acc, const char *spath, int s, const char *aapath,
+		     int x0, int y0, int x1, int y1, struct accum_worth *ws,
+		     struct accum_worth *wa, char *err, size_t errlen)
+{
+	struct image si = {0}, ai = {0};
+	int soy = 0, aoy = 0, sch[3], ach[3], rc = -1;
+	if (s < 2 || s > 16 || (s & (s - 1)) != 0 || x0 < 0 || y0 < 0 || x1 >= acc->w ||
+	    y1 >= acc->h || x0 > x1 || y0 > y1) {
+		errbuf_printf(err, errlen, "no such region or scale");
+		return -1;
+	}
+	if (image_read_exr_rows(spath, y0 * s, (y1 + 1) * s - 1, &si, &soy, err, errlen) ||
+	    image_read_exr_rows(aapath, y0, y1, &ai, &aoy, err, errlen) ||
+	    rgb_of(&si, spath, sch, err, errlen) || rgb_of(&ai, aapath, ach, err, errlen))
+		goto out;
+	if (si.w != acc->w * s || ai.w != acc->w || soy > y0 * s || soy + si.h < (y1 + 1) * s ||
+	    aoy > y0 || aoy + ai.h <= y1) {
+		errbuf_printf(err, errlen, "'%s' or '%s' is not the region's render", spath, aapath);
+		goto out;
+	}
+	for (int y = y0; y <= y1; y++)
+		for (int x = x0; x <= x1; x++) {
+			size_t i = (size_t)y * acc->w + x;
+			const float *p = ai.px + ((size_t)(y - aoy) * ai.w + x) * ai.nch;
+			double sm[3], am[3] = { p[ach[0]], p[ach[1]], p[ach[2]] };
+			if (accum_has_scale(acc, i, s) || accum_has_scale(acc, i, ACC_AA) ||
+			    !block_mean(&si, soy, sch, s, x, y, sm) || !isfinite(am[0] + am[1] + am[2]))
+				continue;
+			worth_add(acc, i, s, sm, ws);
+			worth_add(acc, i, ACC_AA, am, wa);
+		}
+	rc = 0;
+out:
+	image_release(&si);
+	image_release(&ai);
+	return rc;
 }

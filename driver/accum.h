@@ -11,7 +11,8 @@
  *                  unbiased variance of those samples (0 while samples < 2)
  *   pass           the pass that last added samples (0: the base pass)
  *   scales         the resolution scales already sampled, as a bit mask
- *                  (bit s for scale s; the base pass is scale 1)
+ *                  (bit s for scale s; the base pass is scale 1; bit 0 an
+ *                  antialiased render, ACC_AA)
  *   diff           the error of the mean measured by its last fold: two
  *                  independent estimates of the pixel, the samples before
  *                  (n_a) and the samples added (n_b), differ by d; if each
@@ -45,6 +46,16 @@ enum {
 /* The scales a pixel can be sampled at, in the order they are used. */
 #define ACC_NSCALES 5
 extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
+
+/* The "scale" of an antialiased render (at scale 1, +AM2 +A0 +R4 +J; bit 0
+ * of the mask): its pixels are folded as as many samples as the render
+ * proved to be worth, at most ACC_AA_MAX (see accum_merge_region()). */
+#define ACC_AA 0
+#define ACC_AA_MAX 289
+
+/* From this finest scale on, a pixel's fold differences are its whole
+ * error estimate: its grids have sampled every strip wider than 1/16. */
+#define ACC_EDGE_SCALE 8
 
 /* The channel names, in ACC_* order. */
 extern const char *const accum_names[ACC_NCH];
@@ -84,10 +95,38 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 		       int y0, int x1, int y1, int pass, long *folded, char *err,
 		       size_t errlen);
 
+/*
+ * What new samples of a region were worth: over the pixels that had two
+ * samples or more and lacked the scale, the sum a of their relative sample
+ * variances (per sample) and the sum d of the relative squared differences
+ * between the new samples' mean and the pixels' means.  If the new mean of
+ * each pixel has the squared error of n samples, E[d] = a / n + (the old
+ * means' squared error), so a / d is a lower bound on n.
+ */
+struct accum_worth {
+	double a, d;
+	long pixels;
+};
+
+/* a / d of w, at least 1 and at most ACC_AA_MAX; 0 when a is 0. */
+double accum_worth_samples(const struct accum_worth *w);
+
+/*
+ * The same pixels rendered both ways, at scale s and antialiased: the
+ * worth (struct accum_worth) of each against the pixels' means so far,
+ * summed over the pixels that had two samples or more and neither render,
+ * before either is folded.  Each a / d is a lower bound (the means' own
+ * error is in every d); on the same pixels they compare the renders.
+ */
+int accum_pair_files(const struct image *acc, const char *spath, int s, const char *aapath,
+		     int x0, int y0, int x1, int y1, struct accum_worth *ws,
+		     struct accum_worth *wa, char *err, size_t errlen);
+
 /* The same from the render's file at path, reading only the rows the
- * rectangle needs. */
+ * rectangle needs; adds the render's worth to *worth (may be NULL). */
 int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
-		     int y1, int pass, long *folded, char *err, size_t errlen);
+		     int y1, int pass, long *folded, struct accum_worth *worth, char *err,
+		     size_t errlen);
 
 /* What pixel i's relative errors are relative to: the mean over R, G, B
  * of value^2 + 0.01, the value being fit (the regression's, where finite)

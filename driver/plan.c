@@ -475,7 +475,7 @@ void plan_release(struct plan *pl)
 void plan_job(const struct pov_job *base, const struct plan_region *r, const char *output,
 	      struct pov_region *region, const char **extra, struct pov_job *job)
 {
-	int s = r->scale;
+	int s = r->scale == ACC_AA ? 1 : r->scale;
 	*job = *base;
 	job->output = output;
 	job->width = base->width * s;
@@ -487,9 +487,17 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 	job->region = region;
 	for (size_t k = 0; k < base->nextra; k++)
 		extra[k] = base->extra[k];
-	extra[base->nextra] = "-A";	/* our samples are the s x s grid */
 	job->extra = extra;
-	job->nextra = base->nextra + 1;
+	job->nextra = base->nextra;
+	if (r->scale == ACC_AA) {
+		/* POV-Ray's own adaptive antialiasing, jittered (accum.h) */
+		extra[job->nextra++] = "+AM2";
+		extra[job->nextra++] = "+A0.0";
+		extra[job->nextra++] = "+R4";
+		extra[job->nextra++] = "+J";
+	} else {
+		extra[job->nextra++] = "-A";	/* our samples are the s x s grid */
+	}
 }
 
 int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *outputs)
@@ -509,7 +517,10 @@ int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *ou
 
 void plan_output_name(char *buf, size_t len, const char *dir, int pass, size_t k, int scale)
 {
-	snprintf(buf, len, "%s/p%02d-r%03zu-s%d.exr", dir, pass, k, scale);
+	if (scale == ACC_AA)
+		snprintf(buf, len, "%s/p%02d-r%03zu-aa.exr", dir, pass, k);
+	else
+		snprintf(buf, len, "%s/p%02d-r%03zu-s%d.exr", dir, pass, k, scale);
 }
 
 int plan_regions_save(const char *path, const struct plan *pl, int pass, char *const *outputs,

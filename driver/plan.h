@@ -94,11 +94,12 @@ void plan_release(struct plan *pl);
 
 /*
  * The POV-Ray job for region r of a plan, rendering into output: the
- * region at r->scale times base, with antialiasing off (appended after the
- * user's options, which come from base->extra).  base gives the scene,
+ * region at r->scale times base, with antialiasing off, or at scale 1 with
+ * POV-Ray's antialiasing when r->scale is ACC_AA (the options appended
+ * after the user's, which come from base->extra).  base gives the scene,
  * full size, threads, defines, extra options, work directory and binary;
  * the job borrows region (storage for the scaled rectangle) and extra
- * (storage for base->nextra + 1 pointers).
+ * (storage for base->nextra + 4 pointers).
  */
 void plan_job(const struct pov_job *base, const struct plan_region *r, const char *output,
 	      struct pov_region *region, const char **extra, struct pov_job *job);

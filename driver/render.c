@@ -41,6 +41,7 @@ static const char usage[] =
 	"                       [--workdir DIR] [--keep-workdir] [--resume]\n"
 	"                       [--error-map FILE] [--report FILE.json]\n"
 	"                       [--final auto|samples|reconstruction] [--radiosity-scale K]\n"
+	"                       [--sampler auto|scale|aa]\n"
 	"                       [-q|-v]\n"
 	"                       [-- POVRAY_OPTIONS...]\n"
 	"\n"
@@ -76,7 +77,12 @@ static const char usage[] =
 	"  --error-map FILE      error map EXR (default OUT.errors.exr): error,\n"
 	"                        relerror, samples, order, bandwidth, pass, scales\n"
 	"  --report FILE         JSON report of every pass (default: none)\n"
-	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
+	"  --sampler S           how pixels with 21+ samples get more: scale (resolution\n"
+	"                        scaling, 64 then 256 samples), aa (first, once per pixel,\n"
+	"                        POV-Ray's antialiasing, +AM2 +A0 +R4 +J, weighted by\n"
+	"                        what it proves worth), or auto (default: the first such\n"
+	"                        pass renders half of each region each way, and the\n"
+	"                        rest of the run uses the one worth more per CPU second)\n"	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
 	"                        pixel's samples; default), auto (the sample mean or the\n"
 	"                        regression's fit, whichever is predicted closer), or\n"
 	"                        reconstruction (the fit everywhere); see the README\n"
@@ -125,6 +131,13 @@ struct run {
 	double target, budget, timeout;
 	double user_cost_job, user_cost_sample;	/* 0: measure */
 	int user_rad_scale;	/* --radiosity-scale: -1 choose, 0 no radiosity pass */
+	int sampler;		/* --sampler: SAMPLER_* */
+	/* --sampler auto: 0 undecided, 1 antialiasing, -1 scaling */
+	int aa_state;
+	/* the trial (choose_samplers()): what each sampler was worth on the
+	 * same pixels, and its CPU seconds (TRIAL_AA, TRIAL_SCALE) */
+	struct accum_worth trial_worth[2];
+	double trial_cpu[2];
 	enum accum_final final;
 	const char *const *extra;
 	size_t nextra;
@@ -145,6 +158,10 @@ struct run {
 	/* progress while a pool runs */
 	int pool_done, pool_total, pool_pass;
 };
+
+enum { SAMPLER_AUTO, SAMPLER_SCALE, SAMPLER_AA };
+static const char *const sampler_names[] = { "auto", "scale", "aa" };
+enum { TRIAL_AA, TRIAL_SCALE };
 
 static void progress(struct run *r, const char *fmt, ...)
 	__attribute__((format(printf, 2, 3)));
@@ -231,8 +248,8 @@ static int save_progress(struct run *r, char *err, size_t errlen)
 		errbuf_printf(err, errlen, "out of memory");
 		return -1;
 	}
-	int n = snprintf(s, cap, "model %.17g %.17g %.17g %d %d\n", r->cost_job, r->cost_sample,
-			 r->latency, r->radiosity, r->rad_scale);
+	int n = snprintf(s, cap, "model %.17g %.17g %.17g %d %d %d\n", r->cost_job,
+			 r->cost_sample, r->latency, r->radiosity, r->rad_scale, r->aa_state);
 	for (size_t k = 0; k < r->npasses; k++) {
 		const struct pass_rec *p = &r->passes[k];
 		n += snprintf(s + n, cap - n, "pass %d %.6f %.6f %.6f %d %d %d %ld %.17g %.9g %.6f\n",
@@ -256,8 +273,8 @@ static int load_progress(struct run *r, char *err, size_t errlen)
 	int ok = 0;
 	for (char *save = NULL, *line = strtok_r(s, "\n", &save); line;
 	     line = strtok_r(NULL, "\n", &save)) {
-		if (sscanf(line, "model %lf %lf %lf %d %d", &r->cost_job, &r->cost_sample,
-			   &r->latency, &r->radiosity, &r->rad_scale) >= 4) {
+		if (sscanf(line, "model %lf %lf %lf %d %d %d", &r->cost_job, &r->cost_sample,
+			   &r->latency, &r->radiosity, &r->rad_scale, &r->aa_state) >= 4) {
 			ok |= 1;
 			continue;
 		}
@@ -410,8 +427,18 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 	json_str(f, r->stop ? r->stop : "");
 	fprintf(f, ",\n  \"cost_model\": {\"job_s\": %.17g, \"sample_s\": %.17g, "
 		"\"latency_s\": %.6g},\n  \"radiosity\": %s,\n  \"radiosity_scale\": %d,\n"
-		"  \"passes\": [\n", r->cost_job, r->cost_sample, r->latency,
-		r->radiosity ? "true" : "false", r->rad_scale);
+		"  \"sampler\": \"%s\",\n  \"sampler_chosen\": \"%s\",\n", r->cost_job,
+		r->cost_sample, r->latency, r->radiosity ? "true" : "false", r->rad_scale,
+		sampler_names[r->sampler],
+		r->sampler != SAMPLER_AUTO ? sampler_names[r->sampler] :
+		r->aa_state > 0 ? "aa" : r->aa_state < 0 ? "scale" : "undecided");
+	if (r->trial_worth[TRIAL_AA].pixels)
+		fprintf(f, "  \"sampler_trial\": {\"pixels\": %ld, \"aa_samples\": %.4g, "
+			"\"aa_cpu_s\": %.3f, \"scale_samples\": %.4g, \"scale_cpu_s\": %.3f},\n",
+			r->trial_worth[TRIAL_AA].pixels,
+			accum_worth_samples(&r->trial_worth[TRIAL_AA]), r->trial_cpu[TRIAL_AA],
+			accum_worth_samples(&r->trial_worth[TRIAL_SCALE]), r->trial_cpu[TRIAL_SCALE]);
+	fputs("  \"passes\": [\n", f);
 	for (size_t k = 0; k < r->npasses; k++) {
 		const struct pass_rec *p = &r->passes[k];
 		fprintf(f, "    {\"pass\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, "
@@ -666,6 +693,118 @@ out:
 	return ret;
 }
 
+/* Pixels of region g that have had no antialiased render. */
+static long lacking_aa(const struct run *r, const struct plan_region *g)
+{
+	long n = 0;
+	for (int y = g->y0; y <= g->y1; y++)
+		for (int x = g->x0; x <= g->x1; x++)
+			n += !accum_has_scale(&r->acc, (size_t)y * r->w + x, ACC_AA);
+	return n;
+}
+
+/*
+ * The sampler of each fine region of a plan (scale 8 or 16: its pixels have
+ * 21 samples or more), for the regions most of whose pixels have had no
+ * antialiased render (once per pixel: its jitter pattern is the same every
+ * run): resolution scaling, or POV-Ray's own antialiasing (ACC_AA).
+ *
+ * With --sampler auto, the first pass with such regions is a trial: each
+ * region is split in two halves rendered at its scale, and one of them
+ * (alternately the first and the second) is also rendered antialiased, so
+ * the two samplers can be compared on the same pixels (trial_decide()).
+ * twin[k] (-1 for the others) names an antialiased region's scaled half.
+ * Returns 1 for a trial, 0 otherwise, -1 when out of memory.
+ */
+static int choose_samplers(const struct run *r, struct plan *pl, int **twin)
+{
+	*twin = NULL;
+	if (r->sampler == SAMPLER_SCALE || (r->sampler == SAMPLER_AUTO && r->aa_state < 0))
+		return 0;
+	int trial = r->sampler == SAMPLER_AUTO && r->aa_state == 0;
+	size_t n = pl->nregions, m = 0;
+	struct plan_region *out = calloc(3 * n + 1, sizeof(*out));
+	int *tw = calloc(3 * n + 1, sizeof(*tw));
+	if (!out || !tw) {
+		free(out);
+		free(tw);
+		return -1;
+	}
+	int split = 0;
+	for (size_t k = 0; k < n; k++) {
+		struct plan_region g = pl->regions[k];
+		long area = (long)(g.x1 - g.x0 + 1) * (g.y1 - g.y0 + 1);
+		int w = g.x1 - g.x0 + 1, h = g.y1 - g.y0 + 1;
+		tw[m] = -1;
+		if (g.scale < 8 || 2 * lacking_aa(r, &g) < area) {
+			out[m++] = g;
+		} else if (!trial) {
+			g.scale = ACC_AA;
+			out[m++] = g;
+		} else if (w >= 2 || h >= 2) {
+			struct plan_region a = g, b = g;
+			if (w >= h) {
+				a.x1 = g.x0 + w / 2 - 1;
+				b.x0 = a.x1 + 1;
+			} else {
+				a.y1 = g.y0 + h / 2 - 1;
+				b.y0 = a.y1 + 1;
+			}
+			a.gain = b.gain = g.gain / 2;
+			a.cost = b.cost = g.cost / 2;
+			a.chosen = g.chosen / 2;
+			b.chosen = g.chosen - a.chosen;
+			out[m] = a;
+			tw[m++] = -1;
+			out[m] = b;
+			tw[m++] = -1;
+			out[m] = split % 2 ? b : a;
+			out[m].scale = ACC_AA;
+			tw[m] = (int)m - (split % 2 ? 1 : 2);
+			m++;
+			split++;
+		} else {
+			out[m++] = g;
+		}
+	}
+	free(pl->regions);
+	pl->regions = out;
+	pl->nregions = m;
+	if (!split) {
+		free(tw);
+		return 0;
+	}
+	*twin = tw;
+	return 1;
+}
+
+/*
+ * After a trial pass: the sampler that is worth more samples per pixel per
+ * CPU second on the same pixels (accum_pair_files()) wins for the rest of
+ * the run.  Both worths are lower bounds that the pixels' own error (in
+ * both) pulls together, so antialiasing wins only by a margin of 1.5 and
+ * where its bound is 16 samples or more (the pixels' samples at scale 4):
+ * below that, the pixels' error swamps the comparison (a sample grid's
+ * aliasing, as on soft_shadows at 80x60).
+ * Antialiasing wins on area-light noise, where it subdivides only the
+ * pixels whose corners differ; scaling under focal blur, where POV-Ray's
+ * antialiasing stalls at its own answer.
+ */
+static void trial_decide(struct run *r)
+{
+	const struct accum_worth *wa = &r->trial_worth[TRIAL_AA], *ws = &r->trial_worth[TRIAL_SCALE];
+	if (!wa->pixels || !(r->trial_cpu[TRIAL_AA] > 0.0) || !(r->trial_cpu[TRIAL_SCALE] > 0.0))
+		return;		/* nothing to go by: the next fine pass tries again */
+	double na = accum_worth_samples(wa), ns = accum_worth_samples(ws);
+	double ea = na / r->trial_cpu[TRIAL_AA], es = ns / r->trial_cpu[TRIAL_SCALE];
+	r->aa_state = na >= 16.0 && ea > 1.5 * es ? 1 : -1;
+	progress(r, "sampler trial on %ld pixels: antialiasing worth %.0f samples per pixel for "
+		 "%.2f CPU s, scaling %.0f for %.2f s: %s from now on", wa->pixels, na,
+		 r->trial_cpu[TRIAL_AA], ns, r->trial_cpu[TRIAL_SCALE],
+		 r->aa_state > 0 ? "antialiasing" : "scaling");
+	progress_end(r);
+}
+
 /*
  * One refinement pass from the error estimate r->est.  Returns 0 when a
  * pass ran, PASS_STOP when the planner stopped the run (r->stop says why),
@@ -698,6 +837,17 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		r->stop = plan_outcome_name(pl.outcome);
 		plan_release(&pl);
 		return PASS_STOP;
+	}
+	int *twin = NULL;
+	int trial = choose_samplers(r, &pl, &twin);
+	if (trial < 0) {
+		errbuf_printf(err, errlen, "out of memory");
+		plan_release(&pl);
+		return -1;
+	}
+	if (trial) {
+		memset(r->trial_worth, 0, sizeof r->trial_worth);
+		memset(r->trial_cpu, 0, sizeof r->trial_cpu);
 	}
 	size_t n = pl.nregions;
 	struct pov_job *jobs = calloc(n, sizeof(*jobs));
@@ -763,34 +913,56 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		goto out;
 	struct pass_rec p = {0};
 	p.pass = pass;
-	for (size_t k = 0; k < n; k++) {
+	/* the trial's comparison, before either render of its pixels is folded */
+	for (size_t k = 0; trial && k < n; k++) {
+		int tw = twin[k];
+		if (tw < 0 || results[k].status != POV_OK || results[tw].status != POV_OK)
+			continue;
 		const struct plan_region *g = &pl.regions[k];
-		p.cpu_s += results[k].cpu_s;
-		p.invocations += results[k].attempts;
-		if (results[k].status != POV_OK) {
-			if (results[k].status != POV_CANCELLED) {
-				p.failed++;
-				fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s%s%s\n",
-					pass, g->x0, g->y0, g->x1, g->y1,
-					pov_status_name(results[k].status),
-					results[k].message[0] ? ": " : "", results[k].message);
+		char why[512];
+		if (accum_pair_files(&r->acc, outs[tw], pl.regions[tw].scale, outs[k], g->x0,
+				     g->y0, g->x1, g->y1, &r->trial_worth[TRIAL_SCALE],
+				     &r->trial_worth[TRIAL_AA], why, sizeof why))
+			fprintf(stderr, "povpress render: pass %d, sampler trial: %s\n", pass, why);
+		r->trial_cpu[TRIAL_AA] += results[k].cpu_s;
+		r->trial_cpu[TRIAL_SCALE] += results[tw].cpu_s;
+	}
+	/* the scaled renders, then the antialiased ones (weighted by what they
+	 * are worth against the means with the scaled samples) */
+	for (int aa = 0; aa < 2; aa++) {
+		if (aa && trial)
+			trial_decide(r);
+		for (size_t k = 0; k < n; k++) {
+			const struct plan_region *g = &pl.regions[k];
+			int s = g->scale;
+			if ((s == ACC_AA) != aa)
+				continue;
+			p.cpu_s += results[k].cpu_s;
+			p.invocations += results[k].attempts;
+			if (results[k].status != POV_OK) {
+				if (results[k].status != POV_CANCELLED) {
+					p.failed++;
+					fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: "
+						"%s%s%s\n", pass, g->x0, g->y0, g->x1, g->y1,
+						pov_status_name(results[k].status),
+						results[k].message[0] ? ": " : "", results[k].message);
+				}
+				continue;
 			}
-			continue;
+			long folded = 0;
+			if (accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1, pass,
+					     &folded, NULL, err, errlen)) {
+				fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n",
+					pass, g->x0, g->y0, g->x1, g->y1, err);
+				p.failed++;
+				continue;
+			}
+			p.regions++;
+			p.pixels += folded;
+			p.samples += s == ACC_AA ? 0.0 : (double)folded * s * s;
+			if (!r->keep)
+				unlink(outs[k]);
 		}
-		long folded = 0;
-		int s = g->scale;
-		if (accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1, pass,
-				     &folded, err, errlen)) {
-			fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n", pass,
-				g->x0, g->y0, g->x1, g->y1, err);
-			p.failed++;
-			continue;
-		}
-		p.regions++;
-		p.pixels += folded;
-		p.samples += (double)folded * s * s;
-		if (!r->keep)
-			unlink(outs[k]);
 	}
 	p.wall_s = now_s() - t;
 	p.driver_cpu_s = self_cpu() - c;
@@ -818,6 +990,7 @@ out:
 	free(outs);
 	free(results);
 	free(bextra);
+	free(twin);
 	plan_release(&pl);
 	return ret;
 }
@@ -927,6 +1100,14 @@ int cmd_render(int argc, char **argv)
 			r.error_map = argv[++i];
 		} else if (!strcmp(a, "--report")) {
 			r.report = argv[++i];
+		} else if (!strcmp(a, "--sampler")) {
+			const char *m = argv[++i];
+			int k = 0;
+			while (k < 3 && strcmp(m, sampler_names[k]))
+				k++;
+			if (k == 3)
+				goto bad;
+			r.sampler = k;
 		} else if (!strcmp(a, "--final")) {
 			const char *m = argv[++i];
 			if (!strcmp(m, "auto"))

@@ -387,6 +387,112 @@ static void test_merge_nonfinite(void **state)
 	image_release(&acc);
 }
 
+/* 3b. An antialiased render (ACC_AA) is folded as the samples it proves to
+ * be worth: n = sum A / sum D over the region (accum.c, aa_worth()). */
+static double aa_mean(int i, int c)
+{
+	return 0.2 + 0.1 * i + 0.05 * c;
+}
+
+static void test_merge_aa(void **state)
+{
+	struct image acc, r;
+	char err[256];
+	long folded = -1;
+	const double var[3] = { 0.04, 0.02, 0.01 }, dev[4] = { 0.03, -0.05, 0.02, 0.06 };
+
+	(void)state;
+	make_acc(&acc, 4, 2, flat_value);
+	/* row 0: four pixels with 16 samples each (pixel 2 has a fold
+	 * difference); row 1 keeps its one base sample */
+	for (int i = 0; i < 4; i++) {
+		float *o = accpx(&acc, (size_t)i);
+		for (int c = 0; c < 3; c++) {
+			o[c] = (float)aa_mean(i, c);
+			o[ACC_VAR_R + c] = (float)var[c];
+		}
+		o[ACC_SAMPLES] = 16.0f;
+		o[ACC_DIFF] = i == 2 ? 1e-3f : NAN;
+	}
+	assert_int_equal(image_init(&r, 4, 2, 3, rgb_names, err, sizeof(err)), 0);
+	double sa = 0.0, sd = 0.0;
+	for (int i = 0; i < 8; i++)
+		for (int c = 0; c < 3; c++) {
+			double m = accpx(&acc, (size_t)i)[c];
+			r.px[i * 3 + c] = (float)(i < 4 ? m + dev[i] : m + 0.1);
+			if (i < 4) {
+				double den = m * m + 0.01, d = r.px[i * 3 + c] - m;
+				sa += var[c] / den / 3.0;
+				sd += d * d / den / 3.0;
+			}
+		}
+	int n = (int)lround(sa / sd);
+	assert_true(n > 1 && n < ACC_AA_MAX);
+	float before[8][ACC_NCH];
+	for (int i = 0; i < 8; i++)
+		memcpy(before[i], accpx(&acc, (size_t)i), sizeof(before[i]));
+
+	assert_int_equal(accum_merge_region(&acc, &r, 0, ACC_AA, 0, 0, 3, 1, 4, &folded, err,
+					    sizeof(err)), 0);
+	assert_int_equal(folded, 8);
+	for (int i = 0; i < 4; i++) {
+		const float *o = accpx(&acc, (size_t)i);
+		double wa = 16.0 / (16 + n), wb = n / (16.0 + n), d = 0.0;
+		assert_true(o[ACC_SAMPLES] == (float)(16 + n));
+		assert_true(accum_has_scale(&acc, (size_t)i, ACC_AA));
+		assert_true(o[ACC_PASS] == 4.0f);
+		for (int c = 0; c < 3; c++) {
+			double m = before[i][c], a = r.px[i * 3 + c], mt = wa * m + wb * a;
+			assert_close(o[c], mt, 1e-6, 0.0, "weighted mean");
+			/* the render's samples spread as the pixel's do */
+			double m2 = var[c] * 15 + var[c] * (n - 1) + (a - m) * (a - m) * 16.0 * n /
+				    (16 + n);
+			assert_close(o[ACC_VAR_R + c], m2 / (15 + n), 1e-5, 0.0, "variance");
+			d += (a - m) * (a - m) / (mt * mt + 0.01) / 3.0;
+		}
+		double want = wb * wb * d + (i == 2 ? wa * wa * 1e-3 : 0.0);
+		assert_close(o[ACC_DIFF], want, 1e-5, 0.0, "difference over the weights");
+	}
+	/* a pixel with one sample has no spread to weigh the render by: the
+	 * render counts as one sample */
+	for (int i = 4; i < 8; i++) {
+		const float *o = accpx(&acc, (size_t)i);
+		assert_true(o[ACC_SAMPLES] == 2.0f);
+		assert_close(o[0], (before[i][0] + r.px[i * 3]) / 2.0, 1e-6, 0.0, "two samples");
+	}
+	/* once per pixel: the same render again changes nothing */
+	float after[ACC_NCH];
+	memcpy(after, accpx(&acc, 0), sizeof(after));
+	assert_int_equal(accum_merge_region(&acc, &r, 0, ACC_AA, 0, 0, 3, 1, 5, &folded, err,
+					    sizeof(err)), 0);
+	assert_int_equal(folded, 0);
+	assert_memory_equal(after, accpx(&acc, 0), sizeof(after));
+	/* the render is at scale 1: a 2x render is the wrong size */
+	struct image big;
+	make_render(&big, 8, 0, 4, 2);
+	assert_int_equal(accum_merge_region(&acc, &big, 0, ACC_AA, 0, 0, 3, 1, 5, &folded, err,
+					    sizeof(err)), -1);
+	assert_non_null(strstr(err, "8 pixels wide, not 4"));
+	image_release(&big);
+	image_release(&acc);
+
+	/* a render equal to the means is worth ACC_AA_MAX samples, no more */
+	make_acc(&acc, 4, 2, flat_value);
+	for (int i = 0; i < 8; i++) {
+		float *o = accpx(&acc, (size_t)i);
+		for (int c = 0; c < 3; c++) {
+			o[ACC_VAR_R + c] = (float)var[c];
+			r.px[i * 3 + c] = o[c];
+		}
+		o[ACC_SAMPLES] = 9.0f;
+	}
+	assert_int_equal(accum_merge_region(&acc, &r, 0, ACC_AA, 0, 0, 3, 1, 1, &folded, err,
+					    sizeof(err)), 0);
+	assert_true(accpx(&acc, 5)[ACC_SAMPLES] == (float)(9 + ACC_AA_MAX));
+	image_release(&r);
+	image_release(&acc);
+}
+
 /* 4. accum_read round-trips an accumulation; a missing channel is named. */
 static void test_accum_read(void **state)
 {
@@ -746,6 +852,26 @@ static void test_plan_job(void **state)
 	assert_string_equal(job.extra[2], "-A");
 	assert_string_equal(base.output, "base.exr");
 	assert_int_equal(base.nextra, 2);
+
+	/* an antialiased region: scale 1, POV-Ray's antialiasing, jittered */
+	const char *aextra[6];
+	r.scale = ACC_AA;
+	plan_job(&base, &r, "out/a.exr", &region, aextra, &job);
+	assert_int_equal(job.width, 64);
+	assert_int_equal(job.height, 48);
+	assert_int_equal(region.x0, 3);
+	assert_int_equal(region.y1, 7);
+	assert_int_equal(job.nextra, 6);
+	assert_string_equal(job.extra[1], "Antialias_Threshold=0.1");
+	assert_string_equal(job.extra[2], "+AM2");
+	assert_string_equal(job.extra[3], "+A0.0");
+	assert_string_equal(job.extra[4], "+R4");
+	assert_string_equal(job.extra[5], "+J");
+	char name[64];
+	plan_output_name(name, sizeof(name), "w", 3, 7, ACC_AA);
+	assert_string_equal(name, "w/p03-r007-aa.exr");
+	plan_output_name(name, sizeof(name), "w", 3, 7, 8);
+	assert_string_equal(name, "w/p03-r007-s8.exr");
 }
 
 int main(void)
@@ -754,6 +880,7 @@ int main(void)
 		cmocka_unit_test(test_fold),
 		cmocka_unit_test(test_merge_region),
 		cmocka_unit_test(test_merge_nonfinite),
+		cmocka_unit_test(test_merge_aa),
 		cmocka_unit_test(test_accum_read),
 		cmocka_unit_test(test_read_rows),
 		cmocka_unit_test(test_plan_make),
