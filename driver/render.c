@@ -77,12 +77,13 @@ static const char usage[] =
 	"  --error-map FILE      error map EXR (default OUT.errors.exr): error,\n"
 	"                        relerror, samples, order, bandwidth, pass, scales\n"
 	"  --report FILE         JSON report of every pass (default: none)\n"
-	"  --sampler S           how pixels with 21+ samples get more: scale (resolution\n"
-	"                        scaling, 64 then 256 samples), aa (first, once per pixel,\n"
-	"                        POV-Ray's antialiasing, +AM2 +A0 +R4 +J, weighted by\n"
-	"                        what it proves worth), or auto (default: the first such\n"
-	"                        pass renders half of each region each way, and the\n"
-	"                        rest of the run uses the one worth more per CPU second)\n"	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
+	"  --sampler S           how pixels with 21+ samples get more: scale (default:\n"
+	"                        resolution scaling, 64 then 256 samples), aa (first, once\n"
+	"                        per pixel, POV-Ray's antialiasing, +AM2 +A0 +R4 +J,\n"
+	"                        weighted by what it proves worth), or auto (the first\n"
+	"                        such pass renders half of each region both ways and the\n"
+	"                        run keeps the one worth more per CPU second); aa and\n"
+	"                        auto are experimental, see the README\n"	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
 	"                        pixel's samples; default), auto (the sample mean or the\n"
 	"                        regression's fit, whichever is predicted closer), or\n"
 	"                        reconstruction (the fit everywhere); see the README\n"
@@ -1036,6 +1037,7 @@ int cmd_render(int argc, char **argv)
 	r.final = ACC_FINAL_SAMPLES;
 	r.rad_scale = 1;
 	r.user_rad_scale = -1;
+	r.sampler = SAMPLER_SCALE;
 	char emap[PATH_MAX], wdir[PATH_MAX];
 
 	int i = 1;
