@@ -122,6 +122,19 @@ int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
 }
 
 /*
+ * What new samples of a region were worth: over the pixels that had two
+ * samples or more and lacked the scale, the sum a of their relative sample
+ * variances (per sample) and the sum d of the relative squared differences
+ * between the new samples' mean and the pixels' means.  If the new mean of
+ * each pixel has the squared error of n samples, E[d] = a / n + (the old
+ * means' squared error), so a / d is a lower bound on n.
+ */
+struct accum_worth {
+	double a, d;
+	long pixels;
+};
+
+/*
  * Add pixel i's terms to w for new samples of mean mean[3] (see
  * struct accum_worth): its relative sample variance A_i and the relative
  * squared difference D_i between the new mean and its mean.  A pixel
@@ -147,7 +160,8 @@ static void worth_add(const struct image *acc, size_t i, int s, const double mea
 	w->pixels++;
 }
 
-double accum_worth_samples(const struct accum_worth *w)
+/* a / d of w, at least 1 and at most ACC_AA_MAX; 0 when a is 0. */
+static double worth_samples(const struct accum_worth *w)
 {
 	if (!(w->a > 0.0))
 		return 0.0;
@@ -156,7 +170,7 @@ double accum_worth_samples(const struct accum_worth *w)
 	return w->a / w->d < 1.0 ? 1.0 : w->a / w->d;
 }
 
-/* The worth of an antialiased render of a region (accum_worth_samples()),
+/* The worth of an antialiased render of a region (worth_samples()),
  * rounded, and its sums into w. */
 static int aa_worth(const struct image *acc, const struct image *img, int oy, const int ch[3],
 		    int x0, int y0, int x1, int y1, struct accum_worth *w)
@@ -167,14 +181,15 @@ static int aa_worth(const struct image *acc, const struct image *img, int oy, co
 			double mean[3] = { p[ch[0]], p[ch[1]], p[ch[2]] };
 			worth_add(acc, (size_t)y * acc->w + x, ACC_AA, mean, w);
 		}
-	return (int)lround(accum_worth_samples(w));
+	return (int)lround(worth_samples(w));
 }
 
 /* Fold an antialiased render at scale 1 (see aa_worth()). */
 static long merge_aa(struct image *acc, const struct image *img, int oy, const int ch[3],
-		     int x0, int y0, int x1, int y1, int pass, struct accum_worth *w)
+		     int x0, int y0, int x1, int y1, int pass)
 {
-	int n = aa_worth(acc, img, oy, ch, x0, y0, x1, y1, w);
+	struct accum_worth w = {0};
+	int n = aa_worth(acc, img, oy, ch, x0, y0, x1, y1, &w);
 	long count = 0;
 	for (int y = y0; y <= y1; y++)
 		for (int x = x0; x <= x1; x++) {
@@ -196,7 +211,7 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			if (k > 1) {
 				struct accum_worth one = {0};
 				worth_add(acc, i, ACC_AA, mean, &one);
-				double own = accum_worth_samples(&one);
+				double own = worth_samples(&one);
 				if (own < k)
 					k = own >= 1.0 ? (int)lround(own) : 1;
 			}
@@ -226,13 +241,10 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 	return count;
 }
 
-static int merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
-			int y0, int x1, int y1, int pass, long *folded, struct accum_worth *w,
-			char *err, size_t errlen)
+int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
+		       int y0, int x1, int y1, int pass, long *folded, char *err,
+		       size_t errlen)
 {
-	struct accum_worth scratch = {0};
-	if (!w)
-		w = &scratch;
 	if (folded)
 		*folded = 0;
 	if (s != ACC_AA && (s < 1 || s > 16 || (s & (s - 1)) != 0)) {
@@ -264,7 +276,7 @@ static int merge_region(struct image *acc, const struct image *img, int oy, int 
 	}
 	const int ch[3] = { ir, ig, ib };
 	if (s == ACC_AA) {
-		long c = merge_aa(acc, img, oy, ch, x0, y0, x1, y1, pass, w);
+		long c = merge_aa(acc, img, oy, ch, x0, y0, x1, y1, pass);
 		if (folded)
 			*folded = c;
 		return 0;
@@ -300,8 +312,6 @@ static int merge_region(struct image *acc, const struct image *img, int oy, int 
 						mean[c] = n ? sum[c] / n : 0.0;
 			}
 			size_t i = (size_t)y * acc->w + x;
-			if (n)
-				worth_add(acc, i, s, mean, w);
 			if (!accum_fold(acc, i, s, n, mean, m2, pass) && n)
 				count++;
 		}
@@ -311,16 +321,8 @@ static int merge_region(struct image *acc, const struct image *img, int oy, int 
 	return 0;
 }
 
-int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
-		       int y0, int x1, int y1, int pass, long *folded, char *err,
-		       size_t errlen)
-{
-	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, folded, NULL, err, errlen);
-}
-
 int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
-		     int y1, int pass, long *folded, struct accum_worth *worth, char *err,
-		     size_t errlen)
+		     int y1, int pass, long *folded, char *err, size_t errlen)
 {
 	struct image img = {0};
 	int oy = 0;
@@ -328,7 +330,7 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 		*folded = 0;
 	const int k = s == ACC_AA ? 1 : s;
 	int rc = image_read_exr_rows(path, y0 * k, (y1 + 1) * k - 1, &img, &oy, err, errlen) ||
-		 merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, folded, worth, err, errlen);
+		 accum_merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, folded, err, errlen);
 	image_release(&img);
 	return rc ? -1 : 0;
 }
@@ -469,73 +471,4 @@ long accum_final_image(const struct image *acc, const float *fit, const float *p
 		took += use_fit;
 	}
 	return took;
-}
-
-/* The mean of pixel (x, y)'s s x s block of img (rows from oy) in mean[3];
- * 0 when a sample is not finite. */
-static int block_mean(const struct image *img, int oy, const int ch[3], int s, int x, int y,
-		      double mean[3])
-{
-	mean[0] = mean[1] = mean[2] = 0.0;
-	for (int j = 0; j < s; j++)
-		for (int k = 0; k < s; k++) {
-			const float *p = img->px +
-				((size_t)(y * s + j - oy) * img->w + (size_t)x * s + k) * img->nch;
-			for (int c = 0; c < 3; c++) {
-				if (!isfinite(p[ch[c]]))
-					return 0;
-				mean[c] += p[ch[c]] / ((double)s * s);
-			}
-		}
-	return 1;
-}
-
-static int rgb_of(const struct image *img, const char *path, int ch[3], char *err, size_t errlen)
-{
-	ch[0] = image_channel(img, "R");
-	ch[1] = image_channel(img, "G");
-	ch[2] = image_channel(img, "B");
-	if (ch[0] < 0 || ch[1] < 0 || ch[2] < 0) {
-		errbuf_printf(err, errlen, "'%s' has no R, G and B channels", path);
-		return -1;
-	}
-	return 0;
-}
-
-int accum_pair_files(const struct image *acc, const char *spath, int s, const char *aapath,
-		     int x0, int y0, int x1, int y1, struct accum_worth *ws,
-		     struct accum_worth *wa, char *err, size_t errlen)
-{
-	struct image si = {0}, ai = {0};
-	int soy = 0, aoy = 0, sch[3], ach[3], rc = -1;
-	if (s < 2 || s > 16 || (s & (s - 1)) != 0 || x0 < 0 || y0 < 0 || x1 >= acc->w ||
-	    y1 >= acc->h || x0 > x1 || y0 > y1) {
-		errbuf_printf(err, errlen, "no such region or scale");
-		return -1;
-	}
-	if (image_read_exr_rows(spath, y0 * s, (y1 + 1) * s - 1, &si, &soy, err, errlen) ||
-	    image_read_exr_rows(aapath, y0, y1, &ai, &aoy, err, errlen) ||
-	    rgb_of(&si, spath, sch, err, errlen) || rgb_of(&ai, aapath, ach, err, errlen))
-		goto out;
-	if (si.w != acc->w * s || ai.w != acc->w || soy > y0 * s || soy + si.h < (y1 + 1) * s ||
-	    aoy > y0 || aoy + ai.h <= y1) {
-		errbuf_printf(err, errlen, "'%s' or '%s' is not the region's render", spath, aapath);
-		goto out;
-	}
-	for (int y = y0; y <= y1; y++)
-		for (int x = x0; x <= x1; x++) {
-			size_t i = (size_t)y * acc->w + x;
-			const float *p = ai.px + ((size_t)(y - aoy) * ai.w + x) * ai.nch;
-			double sm[3], am[3] = { p[ach[0]], p[ach[1]], p[ach[2]] };
-			if (accum_has_scale(acc, i, s) || accum_has_scale(acc, i, ACC_AA) ||
-			    !block_mean(&si, soy, sch, s, x, y, sm) || !isfinite(am[0] + am[1] + am[2]))
-				continue;
-			worth_add(acc, i, s, sm, ws);
-			worth_add(acc, i, ACC_AA, am, wa);
-		}
-	rc = 0;
-out:
-	image_release(&si);
-	image_release(&ai);
-	return rc;
 }

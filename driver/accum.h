@@ -95,38 +95,10 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 		       int y0, int x1, int y1, int pass, long *folded, char *err,
 		       size_t errlen);
 
-/*
- * What new samples of a region were worth: over the pixels that had two
- * samples or more and lacked the scale, the sum a of their relative sample
- * variances (per sample) and the sum d of the relative squared differences
- * between the new samples' mean and the pixels' means.  If the new mean of
- * each pixel has the squared error of n samples, E[d] = a / n + (the old
- * means' squared error), so a / d is a lower bound on n.
- */
-struct accum_worth {
-	double a, d;
-	long pixels;
-};
-
-/* a / d of w, at least 1 and at most ACC_AA_MAX; 0 when a is 0. */
-double accum_worth_samples(const struct accum_worth *w);
-
-/*
- * The same pixels rendered both ways, at scale s and antialiased: the
- * worth (struct accum_worth) of each against the pixels' means so far,
- * summed over the pixels that had two samples or more and neither render,
- * before either is folded.  Each a / d is a lower bound (the means' own
- * error is in every d); on the same pixels they compare the renders.
- */
-int accum_pair_files(const struct image *acc, const char *spath, int s, const char *aapath,
-		     int x0, int y0, int x1, int y1, struct accum_worth *ws,
-		     struct accum_worth *wa, char *err, size_t errlen);
-
 /* The same from the render's file at path, reading only the rows the
- * rectangle needs; adds the render's worth to *worth (may be NULL). */
+ * rectangle needs. */
 int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
-		     int y1, int pass, long *folded, struct accum_worth *worth, char *err,
-		     size_t errlen);
+		     int y1, int pass, long *folded, char *err, size_t errlen);
 
 /* What pixel i's relative errors are relative to: the mean over R, G, B
  * of value^2 + 0.01, the value being fit (the regression's, where finite)

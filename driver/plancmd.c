@@ -384,7 +384,7 @@ int cmd_merge(int argc, char **argv)
 			continue;
 		}
 		if (accum_merge_file(&acc, outs[k], g->scale, g->x0, g->y0, g->x1, g->y1,
-				     passes[k], &folded, NULL, why, sizeof why)) {
+				     passes[k], &folded, why, sizeof why)) {
 			errbuf_printf(err, sizeof err, "region %zu of '%s' (%s): %s", k + 1, regp,
 				      outs[k], why);
 			goto fail;

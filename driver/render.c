@@ -41,7 +41,7 @@ static const char usage[] =
 	"                       [--workdir DIR] [--keep-workdir] [--resume]\n"
 	"                       [--error-map FILE] [--report FILE.json]\n"
 	"                       [--final auto|samples|reconstruction] [--radiosity-scale K]\n"
-	"                       [--sampler auto|scale|aa]\n"
+	"                       [--sampler scale|aa]\n"
 	"                       [-q|-v]\n"
 	"                       [-- POVRAY_OPTIONS...]\n"
 	"\n"
@@ -78,12 +78,11 @@ static const char usage[] =
 	"                        relerror, samples, order, bandwidth, pass, scales\n"
 	"  --report FILE         JSON report of every pass (default: none)\n"
 	"  --sampler S           how pixels with 21+ samples get more: scale (default:\n"
-	"                        resolution scaling, 64 then 256 samples), aa (first, once\n"
-	"                        per pixel, POV-Ray's antialiasing, +AM2 +A0 +R4 +J,\n"
-	"                        weighted by what it proves worth), or auto (the first\n"
-	"                        such pass renders half of each region both ways and the\n"
-	"                        run keeps the one worth more per CPU second); aa and\n"
-	"                        auto are experimental, see the README\n"	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
+	"                        resolution scaling, 64 then 256 samples) or aa (first,\n"
+	"                        once per pixel, POV-Ray's antialiasing, +AM2 +A0 +R4 +J,\n"
+	"                        weighted by what it proves worth, then scaling; better\n"
+	"                        on soft shadows and thin geometry, worse under focal\n"
+	"                        blur: see the README)\n"	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
 	"                        pixel's samples; default), auto (the sample mean or the\n"
 	"                        regression's fit, whichever is predicted closer), or\n"
 	"                        reconstruction (the fit everywhere); see the README\n"
@@ -133,12 +132,6 @@ struct run {
 	double user_cost_job, user_cost_sample;	/* 0: measure */
 	int user_rad_scale;	/* --radiosity-scale: -1 choose, 0 no radiosity pass */
 	int sampler;		/* --sampler: SAMPLER_* */
-	/* --sampler auto: 0 undecided, 1 antialiasing, -1 scaling */
-	int aa_state;
-	/* the trial (choose_samplers()): what each sampler was worth on the
-	 * same pixels, and its CPU seconds (TRIAL_AA, TRIAL_SCALE) */
-	struct accum_worth trial_worth[2];
-	double trial_cpu[2];
 	enum accum_final final;
 	const char *const *extra;
 	size_t nextra;
@@ -160,9 +153,8 @@ struct run {
 	int pool_done, pool_total, pool_pass;
 };
 
-enum { SAMPLER_AUTO, SAMPLER_SCALE, SAMPLER_AA };
-static const char *const sampler_names[] = { "auto", "scale", "aa" };
-enum { TRIAL_AA, TRIAL_SCALE };
+enum { SAMPLER_SCALE, SAMPLER_AA };
+static const char *const sampler_names[] = { "scale", "aa" };
 
 static void progress(struct run *r, const char *fmt, ...)
 	__attribute__((format(printf, 2, 3)));
@@ -249,8 +241,8 @@ static int save_progress(struct run *r, char *err, size_t errlen)
 		errbuf_printf(err, errlen, "out of memory");
 		return -1;
 	}
-	int n = snprintf(s, cap, "model %.17g %.17g %.17g %d %d %d\n", r->cost_job,
-			 r->cost_sample, r->latency, r->radiosity, r->rad_scale, r->aa_state);
+	int n = snprintf(s, cap, "model %.17g %.17g %.17g %d %d\n", r->cost_job, r->cost_sample,
+			 r->latency, r->radiosity, r->rad_scale);
 	for (size_t k = 0; k < r->npasses; k++) {
 		const struct pass_rec *p = &r->passes[k];
 		n += snprintf(s + n, cap - n, "pass %d %.6f %.6f %.6f %d %d %d %ld %.17g %.9g %.6f\n",
@@ -274,8 +266,8 @@ static int load_progress(struct run *r, char *err, size_t errlen)
 	int ok = 0;
 	for (char *save = NULL, *line = strtok_r(s, "\n", &save); line;
 	     line = strtok_r(NULL, "\n", &save)) {
-		if (sscanf(line, "model %lf %lf %lf %d %d %d", &r->cost_job, &r->cost_sample,
-			   &r->latency, &r->radiosity, &r->rad_scale, &r->aa_state) >= 4) {
+		if (sscanf(line, "model %lf %lf %lf %d %d", &r->cost_job, &r->cost_sample,
+			   &r->latency, &r->radiosity, &r->rad_scale) >= 4) {
 			ok |= 1;
 			continue;
 		}
@@ -428,17 +420,8 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 	json_str(f, r->stop ? r->stop : "");
 	fprintf(f, ",\n  \"cost_model\": {\"job_s\": %.17g, \"sample_s\": %.17g, "
 		"\"latency_s\": %.6g},\n  \"radiosity\": %s,\n  \"radiosity_scale\": %d,\n"
-		"  \"sampler\": \"%s\",\n  \"sampler_chosen\": \"%s\",\n", r->cost_job,
-		r->cost_sample, r->latency, r->radiosity ? "true" : "false", r->rad_scale,
-		sampler_names[r->sampler],
-		r->sampler != SAMPLER_AUTO ? sampler_names[r->sampler] :
-		r->aa_state > 0 ? "aa" : r->aa_state < 0 ? "scale" : "undecided");
-	if (r->trial_worth[TRIAL_AA].pixels)
-		fprintf(f, "  \"sampler_trial\": {\"pixels\": %ld, \"aa_samples\": %.4g, "
-			"\"aa_cpu_s\": %.3f, \"scale_samples\": %.4g, \"scale_cpu_s\": %.3f},\n",
-			r->trial_worth[TRIAL_AA].pixels,
-			accum_worth_samples(&r->trial_worth[TRIAL_AA]), r->trial_cpu[TRIAL_AA],
-			accum_worth_samples(&r->trial_worth[TRIAL_SCALE]), r->trial_cpu[TRIAL_SCALE]);
+		"  \"sampler\": \"%s\",\n", r->cost_job, r->cost_sample, r->latency,
+		r->radiosity ? "true" : "false", r->rad_scale, sampler_names[r->sampler]);
 	fputs("  \"passes\": [\n", f);
 	for (size_t k = 0; k < r->npasses; k++) {
 		const struct pass_rec *p = &r->passes[k];
@@ -706,104 +689,20 @@ static long lacking_aa(const struct run *r, const struct plan_region *g)
 
 /*
  * The sampler of each fine region of a plan (scale 8 or 16: its pixels have
- * 21 samples or more), for the regions most of whose pixels have had no
- * antialiased render (once per pixel: its jitter pattern is the same every
- * run): resolution scaling, or POV-Ray's own antialiasing (ACC_AA).
- *
- * With --sampler auto, the first pass with such regions is a trial: each
- * region is split in two halves rendered at its scale, and one of them
- * (alternately the first and the second) is also rendered antialiased, so
- * the two samplers can be compared on the same pixels (trial_decide()).
- * twin[k] (-1 for the others) names an antialiased region's scaled half.
- * Returns 1 for a trial, 0 otherwise, -1 when out of memory.
+ * 21 samples or more): resolution scaling, or with --sampler aa POV-Ray's
+ * own antialiasing (ACC_AA) for the regions most of whose pixels have had
+ * none (once per pixel: its jitter pattern is the same every run).
  */
-static int choose_samplers(const struct run *r, struct plan *pl, int **twin)
+static void choose_samplers(const struct run *r, struct plan *pl)
 {
-	*twin = NULL;
-	if (r->sampler == SAMPLER_SCALE || (r->sampler == SAMPLER_AUTO && r->aa_state < 0))
-		return 0;
-	int trial = r->sampler == SAMPLER_AUTO && r->aa_state == 0;
-	size_t n = pl->nregions, m = 0;
-	struct plan_region *out = calloc(3 * n + 1, sizeof(*out));
-	int *tw = calloc(3 * n + 1, sizeof(*tw));
-	if (!out || !tw) {
-		free(out);
-		free(tw);
-		return -1;
+	if (r->sampler != SAMPLER_AA)
+		return;
+	for (size_t k = 0; k < pl->nregions; k++) {
+		struct plan_region *g = &pl->regions[k];
+		long area = (long)(g->x1 - g->x0 + 1) * (g->y1 - g->y0 + 1);
+		if (g->scale >= 8 && 2 * lacking_aa(r, g) >= area)
+			g->scale = ACC_AA;
 	}
-	int split = 0;
-	for (size_t k = 0; k < n; k++) {
-		struct plan_region g = pl->regions[k];
-		long area = (long)(g.x1 - g.x0 + 1) * (g.y1 - g.y0 + 1);
-		int w = g.x1 - g.x0 + 1, h = g.y1 - g.y0 + 1;
-		tw[m] = -1;
-		if (g.scale < 8 || 2 * lacking_aa(r, &g) < area) {
-			out[m++] = g;
-		} else if (!trial) {
-			g.scale = ACC_AA;
-			out[m++] = g;
-		} else if (w >= 2 || h >= 2) {
-			struct plan_region a = g, b = g;
-			if (w >= h) {
-				a.x1 = g.x0 + w / 2 - 1;
-				b.x0 = a.x1 + 1;
-			} else {
-				a.y1 = g.y0 + h / 2 - 1;
-				b.y0 = a.y1 + 1;
-			}
-			a.gain = b.gain = g.gain / 2;
-			a.cost = b.cost = g.cost / 2;
-			a.chosen = g.chosen / 2;
-			b.chosen = g.chosen - a.chosen;
-			out[m] = a;
-			tw[m++] = -1;
-			out[m] = b;
-			tw[m++] = -1;
-			out[m] = split % 2 ? b : a;
-			out[m].scale = ACC_AA;
-			tw[m] = (int)m - (split % 2 ? 1 : 2);
-			m++;
-			split++;
-		} else {
-			out[m++] = g;
-		}
-	}
-	free(pl->regions);
-	pl->regions = out;
-	pl->nregions = m;
-	if (!split) {
-		free(tw);
-		return 0;
-	}
-	*twin = tw;
-	return 1;
-}
-
-/*
- * After a trial pass: the sampler that is worth more samples per pixel per
- * CPU second on the same pixels (accum_pair_files()) wins for the rest of
- * the run.  Both worths are lower bounds that the pixels' own error (in
- * both) pulls together, so antialiasing wins only by a margin of 1.5 and
- * where its bound is 16 samples or more (the pixels' samples at scale 4):
- * below that, the pixels' error swamps the comparison (a sample grid's
- * aliasing, as on soft_shadows at 80x60).
- * Antialiasing wins on area-light noise, where it subdivides only the
- * pixels whose corners differ; scaling under focal blur, where POV-Ray's
- * antialiasing stalls at its own answer.
- */
-static void trial_decide(struct run *r)
-{
-	const struct accum_worth *wa = &r->trial_worth[TRIAL_AA], *ws = &r->trial_worth[TRIAL_SCALE];
-	if (!wa->pixels || !(r->trial_cpu[TRIAL_AA] > 0.0) || !(r->trial_cpu[TRIAL_SCALE] > 0.0))
-		return;		/* nothing to go by: the next fine pass tries again */
-	double na = accum_worth_samples(wa), ns = accum_worth_samples(ws);
-	double ea = na / r->trial_cpu[TRIAL_AA], es = ns / r->trial_cpu[TRIAL_SCALE];
-	r->aa_state = na >= 16.0 && ea > 1.5 * es ? 1 : -1;
-	progress(r, "sampler trial on %ld pixels: antialiasing worth %.0f samples per pixel for "
-		 "%.2f CPU s, scaling %.0f for %.2f s: %s from now on", wa->pixels, na,
-		 r->trial_cpu[TRIAL_AA], ns, r->trial_cpu[TRIAL_SCALE],
-		 r->aa_state > 0 ? "antialiasing" : "scaling");
-	progress_end(r);
 }
 
 /*
@@ -839,17 +738,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		plan_release(&pl);
 		return PASS_STOP;
 	}
-	int *twin = NULL;
-	int trial = choose_samplers(r, &pl, &twin);
-	if (trial < 0) {
-		errbuf_printf(err, errlen, "out of memory");
-		plan_release(&pl);
-		return -1;
-	}
-	if (trial) {
-		memset(r->trial_worth, 0, sizeof r->trial_worth);
-		memset(r->trial_cpu, 0, sizeof r->trial_cpu);
-	}
+	choose_samplers(r, &pl);
 	size_t n = pl.nregions;
 	struct pov_job *jobs = calloc(n, sizeof(*jobs));
 	struct pov_region *regs = calloc(n, sizeof(*regs));
@@ -914,25 +803,9 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		goto out;
 	struct pass_rec p = {0};
 	p.pass = pass;
-	/* the trial's comparison, before either render of its pixels is folded */
-	for (size_t k = 0; trial && k < n; k++) {
-		int tw = twin[k];
-		if (tw < 0 || results[k].status != POV_OK || results[tw].status != POV_OK)
-			continue;
-		const struct plan_region *g = &pl.regions[k];
-		char why[512];
-		if (accum_pair_files(&r->acc, outs[tw], pl.regions[tw].scale, outs[k], g->x0,
-				     g->y0, g->x1, g->y1, &r->trial_worth[TRIAL_SCALE],
-				     &r->trial_worth[TRIAL_AA], why, sizeof why))
-			fprintf(stderr, "povpress render: pass %d, sampler trial: %s\n", pass, why);
-		r->trial_cpu[TRIAL_AA] += results[k].cpu_s;
-		r->trial_cpu[TRIAL_SCALE] += results[tw].cpu_s;
-	}
 	/* the scaled renders, then the antialiased ones (weighted by what they
-	 * are worth against the means with the scaled samples) */
+	 * are worth against the means with this pass's scaled samples) */
 	for (int aa = 0; aa < 2; aa++) {
-		if (aa && trial)
-			trial_decide(r);
 		for (size_t k = 0; k < n; k++) {
 			const struct plan_region *g = &pl.regions[k];
 			int s = g->scale;
@@ -952,7 +825,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			}
 			long folded = 0;
 			if (accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1, pass,
-					     &folded, NULL, err, errlen)) {
+					     &folded, err, errlen)) {
 				fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n",
 					pass, g->x0, g->y0, g->x1, g->y1, err);
 				p.failed++;
@@ -991,7 +864,6 @@ out:
 	free(outs);
 	free(results);
 	free(bextra);
-	free(twin);
 	plan_release(&pl);
 	return ret;
 }
@@ -1105,9 +977,9 @@ int cmd_render(int argc, char **argv)
 		} else if (!strcmp(a, "--sampler")) {
 			const char *m = argv[++i];
 			int k = 0;
-			while (k < 3 && strcmp(m, sampler_names[k]))
+			while (k < 2 && strcmp(m, sampler_names[k]))
 				k++;
-			if (k == 3)
+			if (k == 2)
 				goto bad;
 			r.sampler = k;
 		} else if (!strcmp(a, "--final")) {

@@ -184,7 +184,7 @@ fi
 # --- --sampler: POV-Ray's antialiasing for pixels with 21+ samples ----------
 msg=$("$PP" render "$SC/smooth_empty.pov" -o "$T/x.exr" --sampler jitter 2>&1)
 rc=$?
-check "render with --sampler jitter (not auto, scale or aa) is a usage error (2)" test $rc -eq 2
+check "render with --sampler jitter (not scale or aa) is a usage error (2)" test $rc -eq 2
 check "... whose message names the option" grep -q -- "--sampler" <<<"$msg"
 scene="$SC/soft_shadows.pov"
 if ref=$(reference "$scene"); then
@@ -207,26 +207,13 @@ if ref=$(reference "$scene"); then
 else
 	bad "soft_shadows: reference render failed"
 fi
-# auto: the trial compares the two on the same pixels (160x120: at 80x60
-# the grids' aliasing at the horizon swamps the comparison and it keeps
-# scaling).  Measured: on soft_shadows antialiasing worth 106 samples for
-# 0.87 CPU s against scaling's 35 for 0.81 s; on focal_blur 15 for 1.7 s
-# against 36 for 1.4 s.
-for pair in soft_shadows:aa focal_blur:scale; do
-	name=${pair%%:*} want=${pair#*:}
-	"$PP" render "$SC/$name.pov" -o "$T/auto-$name.exr" -W 160 -H 120 --target 3e-4 \
-		--max-passes 3 --sampler auto -q --report "$T/auto-$name.json" ||
-		bad "--sampler auto ($name): render failed"
-	check "--sampler auto: the trial ran on $name" grep -q '"sampler_trial"' "$T/auto-$name.json"
-	check "--sampler auto: $name keeps $want" \
-		grep -q "\"sampler_chosen\": \"$want\"" "$T/auto-$name.json"
-done
 
 # --- a smooth, nearly empty scene costs almost nothing beyond the base pass --
 "$PP" render "$SC/smooth_empty.pov" -o "$T/smooth.exr" -W $W -H $H -q --report "$T/smooth.json"
 px=$(awk '/"pass": [1-9]/ { for (i = 1; i <= NF; i++) if ($i == "\"pixels\":") s += $(i + 1) }
 	END { print s + 0 }' "$T/smooth.json")
 check "smooth scene: at most 2% of the pixels re-rendered ($px)" num 'a <= 0.02 * b' "$px" $((W * H))
+check "--sampler scale is the default" grep -q '"sampler": "scale"' "$T/smooth.json"
 
 # --- determinism: one job, one POV-Ray thread -------------------------------
 for k in 1 2; do
