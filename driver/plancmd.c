@@ -72,6 +72,8 @@ static const char merge_usage[] =
 	"A pixel that already has a region's scale keeps its samples (the same sample\n"
 	"positions again would add nothing).  --init makes the accumulation of a base\n"
 	"render (one sample per pixel).  R, G, B of an accumulation are the image.\n"
+	"A region of scale 0 (render --sampler aa writes them) is an antialiased\n"
+	"render at scale 1, folded as the samples it proves worth.\n"
 	"\n"
 	"options:\n"
 	"  -o, --output FILE   the new accumulation (may be ACCUM.exr itself)\n"
