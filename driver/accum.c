@@ -121,6 +121,16 @@ int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
 	return 0;
 }
 
+/* The mean over R, G, B of v[c] / (m[c]^2 + 0.01): squared errors v relative
+ * to the values m, a pixel's term of relMSE. */
+static double rel3(const float *m, const double v[3])
+{
+	double r = 0.0;
+	for (int c = 0; c < 3; c++)
+		r += v[c] / ((double)m[c] * m[c] + METRICS_RELMSE_EPS) / 3.0;
+	return r;
+}
+
 /*
  * What new samples of a region were worth: over the pixels that had two
  * samples or more and lacked the scale, the sum a of their relative sample
@@ -146,13 +156,12 @@ static void worth_add(const struct image *acc, size_t i, int s, const double mea
 	const float *o = acc->px + i * ACC_NCH;
 	if (!(o[ACC_SAMPLES] >= 2.0f) || accum_has_scale(acc, i, s))
 		return;
-	double a = 0.0, d = 0.0;
+	double var[3], e2[3];
 	for (int c = 0; c < 3; c++) {
-		double den = (double)o[c] * o[c] + METRICS_RELMSE_EPS;
-		double e = mean[c] - o[c];
-		a += o[ACC_VAR_R + c] / den / 3.0;
-		d += e * e / den / 3.0;
+		var[c] = o[ACC_VAR_R + c];
+		e2[c] = (mean[c] - o[c]) * (mean[c] - o[c]);
 	}
+	double a = rel3(o, var), d = rel3(o, e2);
 	if (!isfinite(a) || !isfinite(d))
 		return;
 	w->a += a;
@@ -171,70 +180,70 @@ static double worth_samples(const struct accum_worth *w)
 }
 
 /* The worth of an antialiased render of a region (worth_samples()),
- * rounded, and its sums into w. */
+ * rounded. */
 static int aa_worth(const struct image *acc, const struct image *img, int oy, const int ch[3],
-		    int x0, int y0, int x1, int y1, struct accum_worth *w)
+		    int x0, int y0, int x1, int y1)
 {
+	struct accum_worth w = {0};
 	for (int y = y0; y <= y1; y++)
 		for (int x = x0; x <= x1; x++) {
 			const float *p = img->px + ((size_t)(y - oy) * img->w + x) * img->nch;
 			double mean[3] = { p[ch[0]], p[ch[1]], p[ch[2]] };
-			worth_add(acc, (size_t)y * acc->w + x, ACC_AA, mean, w);
+			worth_add(acc, (size_t)y * acc->w + x, ACC_AA, mean, &w);
 		}
-	return (int)lround(worth_samples(w));
+	return (int)lround(worth_samples(&w));
 }
 
 /* Fold an antialiased render at scale 1 (see aa_worth()). */
 static long merge_aa(struct image *acc, const struct image *img, int oy, const int ch[3],
 		     int x0, int y0, int x1, int y1, int pass)
 {
-	struct accum_worth w = {0};
-	int n = aa_worth(acc, img, oy, ch, x0, y0, x1, y1, &w);
+	int n = aa_worth(acc, img, oy, ch, x0, y0, x1, y1);
 	long count = 0;
 	for (int y = y0; y <= y1; y++)
 		for (int x = x0; x <= x1; x++) {
 			size_t i = (size_t)y * acc->w + x;
 			const float *o = acc->px + i * ACC_NCH;
 			const float *p = img->px + ((size_t)(y - oy) * img->w + x) * img->nch;
-			double mean[3], m2[3];
+			double mean[3], old[3], m2[3] = { 0.0, 0.0, 0.0 };
 			int ok = 1;
 			for (int c = 0; c < 3; c++) {
 				mean[c] = p[ch[c]];
+				old[c] = o[c];
 				ok &= isfinite(mean[c]) != 0;
 			}
-			/* the render's samples spread as the pixel's do; a pixel
-			 * with no spread to weigh it by takes it as one sample,
-			 * and none takes it as more than its own a / d (a bias
-			 * where the pixel's spread is small would be weighted as
-			 * the region's noisier pixels prove it worth) */
-			int k = !ok ? 0 : n >= 1 && o[ACC_SAMPLES] >= 2.0f ? n : 1;
-			if (k > 1) {
-				struct accum_worth one = {0};
-				worth_add(acc, i, ACC_AA, mean, &one);
-				double own = worth_samples(&one);
-				if (own < k)
-					k = own >= 1.0 ? (int)lround(own) : 1;
+			if (!ok) {
+				accum_fold(acc, i, ACC_AA, 0, mean, m2, pass);
+				continue;
 			}
+			/* the render's samples spread as the pixel's do; no pixel
+			 * takes it as more than its own a / d (a bias where the
+			 * pixel's spread is small would be weighted as the region's
+			 * noisier pixels prove it worth), and a pixel with no
+			 * spread to weigh it by takes it as one sample */
+			struct accum_worth one = {0};
+			worth_add(acc, i, ACC_AA, mean, &one);
+			double own = worth_samples(&one);
+			int k = own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
 			for (int c = 0; c < 3; c++)
 				m2[c] = k > 1 ? (double)o[ACC_VAR_R + c] * (k - 1) : 0.0;
-			double na = o[ACC_SAMPLES], prev = o[ACC_DIFF], d = 0.0;
-			if (accum_fold(acc, i, ACC_AA, k, mean, m2, pass) || !k)
+			double na = o[ACC_SAMPLES], prev = o[ACC_DIFF];
+			if (accum_fold(acc, i, ACC_AA, k, mean, m2, pass))
 				continue;
 			count++;
 			if (!(na > 0.0))
 				continue;
 			/* the error of the new mean, not knowing which of the two
-			 * the difference d between them belongs to (the render
-			 * holds POV-Ray's antialiasing bias: its threshold test
-			 * and area-light patterns converge to their own answer;
-			 * the old mean can hold a sample grid's aliasing): each
-			 * one's weight squared times d, or for the old mean its
-			 * own error if larger */
-			double wa = na / (na + k), wb = k / (na + k);
-			for (int c = 0; c < 3; c++) {
-				double e = mean[c] - (o[c] - wb * mean[c]) / wa;
-				d += e * e / ((double)o[c] * o[c] + METRICS_RELMSE_EPS) / 3.0;
-			}
+			 * the difference between them belongs to (the render holds
+			 * POV-Ray's antialiasing bias: its threshold test and
+			 * area-light patterns converge to their own answer; the old
+			 * mean can hold a sample grid's aliasing): each one's
+			 * weight squared times it, or for the old mean its own
+			 * error if larger */
+			double e2[3];
+			for (int c = 0; c < 3; c++)
+				e2[c] = (mean[c] - old[c]) * (mean[c] - old[c]);
+			double d = rel3(o, e2), wa = na / (na + k), wb = k / (na + k);
 			double em = isfinite(prev) && prev > d ? prev : d;
 			acc->px[i * ACC_NCH + ACC_DIFF] = (float)(wb * wb * d + wa * wa * em);
 		}
@@ -257,7 +266,7 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 			      y0, x1, y1, acc->w, acc->h);
 		return -1;
 	}
-	const int f = s == ACC_AA ? 1 : s;	/* the render's size over acc's */
+	const int f = accum_render_factor(s);
 	if (img->w != acc->w * f) {
 		errbuf_printf(err, errlen, "the render is %d pixels wide, not %d (%d x %d)", img->w,
 			      acc->w * f, acc->w, f);
@@ -328,8 +337,8 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 	int oy = 0;
 	if (folded)
 		*folded = 0;
-	const int k = s == ACC_AA ? 1 : s;
-	int rc = image_read_exr_rows(path, y0 * k, (y1 + 1) * k - 1, &img, &oy, err, errlen) ||
+	const int f = accum_render_factor(s);
+	int rc = image_read_exr_rows(path, y0 * f, (y1 + 1) * f - 1, &img, &oy, err, errlen) ||
 		 accum_merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, folded, err, errlen);
 	image_release(&img);
 	return rc ? -1 : 0;
@@ -417,9 +426,10 @@ double accum_pixel_error(const struct image *acc, size_t i, double press, const 
 	} else if (n >= 4.0) {
 		/* samples from a single render (a radiosity pass): the
 		 * variance of their mean */
-		e = 0.0;
+		double v[3];
 		for (int c = 0; c < 3; c++)
-			e += o[ACC_VAR_R + c] / n / ((double)o[c] * o[c] + METRICS_RELMSE_EPS) / 3.0;
+			v[c] = o[ACC_VAR_R + c] / n;
+		e = rel3(o, v);
 	}
 	/* an edge or a detail between every sample position so far */
 	int fs = finest_scale(acc, i);

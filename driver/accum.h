@@ -53,6 +53,13 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
 #define ACC_AA 0
 #define ACC_AA_MAX 289
 
+/* A region render of scale s is accum_render_factor(s) times the image's
+ * size: s, or 1 for an antialiased render. */
+static inline int accum_render_factor(int s)
+{
+	return s == ACC_AA ? 1 : s;
+}
+
 /* From this finest scale on, a pixel's fold differences are its whole
  * error estimate: its grids have sampled every strip wider than 1/16. */
 #define ACC_EDGE_SCALE 8

@@ -475,7 +475,7 @@ void plan_release(struct plan *pl)
 void plan_job(const struct pov_job *base, const struct plan_region *r, const char *output,
 	      struct pov_region *region, const char **extra, struct pov_job *job)
 {
-	int s = r->scale == ACC_AA ? 1 : r->scale;
+	int s = accum_render_factor(r->scale);
 	*job = *base;
 	job->output = output;
 	job->width = base->width * s;

@@ -82,7 +82,8 @@ static const char usage[] =
 	"                        once per pixel, POV-Ray's antialiasing, +AM2 +A0 +R4 +J,\n"
 	"                        weighted by what it proves worth, then scaling; better\n"
 	"                        on soft shadows and thin geometry, worse under focal\n"
-	"                        blur: see the README)\n"	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
+	"                        blur: see the README)\n"
+	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
 	"                        pixel's samples; default), auto (the sample mean or the\n"
 	"                        regression's fit, whichever is predicted closer), or\n"
 	"                        reconstruction (the fit everywhere); see the README\n"
@@ -153,8 +154,8 @@ struct run {
 	int pool_done, pool_total, pool_pass;
 };
 
-enum { SAMPLER_SCALE, SAMPLER_AA };
-static const char *const sampler_names[] = { "scale", "aa" };
+enum { SAMPLER_SCALE, SAMPLER_AA, NSAMPLERS };
+static const char *const sampler_names[NSAMPLERS] = { "scale", "aa" };
 
 static void progress(struct run *r, const char *fmt, ...)
 	__attribute__((format(printf, 2, 3)));
@@ -420,9 +421,8 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 	json_str(f, r->stop ? r->stop : "");
 	fprintf(f, ",\n  \"cost_model\": {\"job_s\": %.17g, \"sample_s\": %.17g, "
 		"\"latency_s\": %.6g},\n  \"radiosity\": %s,\n  \"radiosity_scale\": %d,\n"
-		"  \"sampler\": \"%s\",\n", r->cost_job, r->cost_sample, r->latency,
-		r->radiosity ? "true" : "false", r->rad_scale, sampler_names[r->sampler]);
-	fputs("  \"passes\": [\n", f);
+		"  \"sampler\": \"%s\",\n  \"passes\": [\n", r->cost_job, r->cost_sample,
+		r->latency, r->radiosity ? "true" : "false", r->rad_scale, sampler_names[r->sampler]);
 	for (size_t k = 0; k < r->npasses; k++) {
 		const struct pass_rec *p = &r->passes[k];
 		fprintf(f, "    {\"pass\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, "
@@ -691,18 +691,26 @@ static long lacking_aa(const struct run *r, const struct plan_region *g)
  * The sampler of each fine region of a plan (scale 8 or 16: its pixels have
  * 21 samples or more): resolution scaling, or with --sampler aa POV-Ray's
  * own antialiasing (ACC_AA) for the regions most of whose pixels have had
- * none (once per pixel: its jitter pattern is the same every run).
+ * none (once per pixel: its jitter pattern is the same every run).  The
+ * antialiased regions go last, keeping their order, so that they are folded
+ * after the scaled ones (their weight is measured against the means with
+ * this pass's scaled samples), in render as in regions.tsv for merge.
  */
 static void choose_samplers(const struct run *r, struct plan *pl)
 {
 	if (r->sampler != SAMPLER_AA)
 		return;
+	size_t m = 0;
 	for (size_t k = 0; k < pl->nregions; k++) {
-		struct plan_region *g = &pl->regions[k];
-		long area = (long)(g->x1 - g->x0 + 1) * (g->y1 - g->y0 + 1);
-		if (g->scale >= 8 && 2 * lacking_aa(r, g) >= area)
-			g->scale = ACC_AA;
+		struct plan_region g = pl->regions[k];
+		long area = (long)(g.x1 - g.x0 + 1) * (g.y1 - g.y0 + 1);
+		if (g.scale >= 8 && 2 * lacking_aa(r, &g) >= area)
+			continue;
+		memmove(pl->regions + m + 1, pl->regions + m, (k - m) * sizeof(g));
+		pl->regions[m++] = g;
 	}
+	for (size_t k = m; k < pl->nregions; k++)
+		pl->regions[k].scale = ACC_AA;
 }
 
 /*
@@ -803,40 +811,34 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		goto out;
 	struct pass_rec p = {0};
 	p.pass = pass;
-	/* the scaled renders, then the antialiased ones (weighted by what they
-	 * are worth against the means with this pass's scaled samples) */
-	for (int aa = 0; aa < 2; aa++) {
-		for (size_t k = 0; k < n; k++) {
-			const struct plan_region *g = &pl.regions[k];
-			int s = g->scale;
-			if ((s == ACC_AA) != aa)
-				continue;
-			p.cpu_s += results[k].cpu_s;
-			p.invocations += results[k].attempts;
-			if (results[k].status != POV_OK) {
-				if (results[k].status != POV_CANCELLED) {
-					p.failed++;
-					fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: "
-						"%s%s%s\n", pass, g->x0, g->y0, g->x1, g->y1,
-						pov_status_name(results[k].status),
-						results[k].message[0] ? ": " : "", results[k].message);
-				}
-				continue;
-			}
-			long folded = 0;
-			if (accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1, pass,
-					     &folded, err, errlen)) {
-				fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n",
-					pass, g->x0, g->y0, g->x1, g->y1, err);
+	for (size_t k = 0; k < n; k++) {
+		const struct plan_region *g = &pl.regions[k];
+		int s = g->scale;
+		p.cpu_s += results[k].cpu_s;
+		p.invocations += results[k].attempts;
+		if (results[k].status != POV_OK) {
+			if (results[k].status != POV_CANCELLED) {
 				p.failed++;
-				continue;
+				fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s%s%s\n",
+					pass, g->x0, g->y0, g->x1, g->y1,
+					pov_status_name(results[k].status),
+					results[k].message[0] ? ": " : "", results[k].message);
 			}
-			p.regions++;
-			p.pixels += folded;
-			p.samples += s == ACC_AA ? 0.0 : (double)folded * s * s;
-			if (!r->keep)
-				unlink(outs[k]);
+			continue;
 		}
+		long folded = 0;
+		if (accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1, pass,
+				     &folded, err, errlen)) {
+			fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n", pass,
+				g->x0, g->y0, g->x1, g->y1, err);
+			p.failed++;
+			continue;
+		}
+		p.regions++;
+		p.pixels += folded;
+		p.samples += s == ACC_AA ? 0.0 : (double)folded * s * s;
+		if (!r->keep)
+			unlink(outs[k]);
 	}
 	p.wall_s = now_s() - t;
 	p.driver_cpu_s = self_cpu() - c;
@@ -977,9 +979,9 @@ int cmd_render(int argc, char **argv)
 		} else if (!strcmp(a, "--sampler")) {
 			const char *m = argv[++i];
 			int k = 0;
-			while (k < 2 && strcmp(m, sampler_names[k]))
+			while (k < NSAMPLERS && strcmp(m, sampler_names[k]))
 				k++;
-			if (k == 2)
+			if (k == NSAMPLERS)
 				goto bad;
 			r.sampler = k;
 		} else if (!strcmp(a, "--final")) {
