@@ -82,7 +82,7 @@ static const char usage[] =
 	"                        once per pixel, POV-Ray's antialiasing, +AM2 +A0 +R4 +J,\n"
 	"                        weighted by what it proves worth, then scaling; better\n"
 	"                        on soft shadows and thin geometry, worse under focal\n"
-	"                        blur: see the README)\n"
+	"                        blur and glossy reflection: see the README)\n"
 	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
 	"                        pixel's samples; default), auto (the sample mean or the\n"
 	"                        regression's fit, whichever is predicted closer), or\n"
