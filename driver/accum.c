@@ -250,6 +250,51 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 	return count;
 }
 
+/* Fold a grid render (ACC_GRID_FRAME; see accum_merge_region()). */
+static long merge_grid(struct image *acc, const struct image *img, int oy, const int ch[3],
+		       int s, int x0, int y0, int x1, int y1, int pass)
+{
+	const int f = ACC_GRID_FRAME, g = accum_grid_samples(s) / 4;	/* per sub-pixel */
+	long count = 0;
+	for (int y = y0; y <= y1; y++)
+		for (int x = x0; x <= x1; x++) {
+			size_t i = (size_t)y * acc->w + x;
+			const float *o = acc->px + i * ACC_NCH;
+			double sub[4][3], mean[3] = { 0.0, 0.0, 0.0 }, m2[3];
+			int nq = 0;
+			for (int j = 0; j < f; j++)
+				for (int l = 0; l < f; l++) {
+					const float *p = img->px +
+						((size_t)(y * f + j - oy) * img->w + (size_t)x * f + l) *
+						img->nch;
+					if (!isfinite(p[ch[0]]) || !isfinite(p[ch[1]]) ||
+					    !isfinite(p[ch[2]]))
+						continue;
+					for (int c = 0; c < 3; c++) {
+						sub[nq][c] = p[ch[c]];
+						mean[c] += p[ch[c]];
+					}
+					nq++;
+				}
+			for (int c = 0; c < 3; c++) {
+				mean[c] = nq ? mean[c] / nq : 0.0;
+				double b = 0.0;
+				for (int q = 0; q < nq; q++)
+					b += (sub[q][c] - mean[c]) * (sub[q][c] - mean[c]);
+				/* per sample: what the sub-pixels' spread means for
+				 * noise, capped by the pixel's own sample variance */
+				double v = nq > 1 ? g * b / (nq - 1) : NAN;
+				double own = o[ACC_SAMPLES] >= 2.0f ? (double)o[ACC_VAR_R + c] : NAN;
+				if (!isfinite(v) || (isfinite(own) && own < v))
+					v = own;
+				m2[c] = g * b + (isfinite(v) ? nq * (g - 1) * v : 0.0);
+			}
+			if (!accum_fold(acc, i, s, nq * g, mean, m2, pass) && nq)
+				count++;
+		}
+	return count;
+}
+
 int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
 		       int y0, int x1, int y1, int pass, long *folded, char *err,
 		       size_t errlen)
@@ -266,10 +311,17 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 			      y0, x1, y1, acc->w, acc->h);
 		return -1;
 	}
-	const int f = accum_render_factor(s);
+	const int grid = s >= 4 && img->w == acc->w * ACC_GRID_FRAME;
+	const int f = grid ? ACC_GRID_FRAME : accum_render_factor(s);
 	if (img->w != acc->w * f) {
-		errbuf_printf(err, errlen, "the render is %d pixels wide, not %d (%d x %d)", img->w,
-			      acc->w * f, acc->w, f);
+		if (s >= 4)
+			errbuf_printf(err, errlen,
+				      "the render is %d pixels wide, not %d (%d x %d) or %d (a grid "
+				      "render)", img->w, acc->w * f, acc->w, f,
+				      acc->w * ACC_GRID_FRAME);
+		else
+			errbuf_printf(err, errlen, "the render is %d pixels wide, not %d (%d x %d)",
+				      img->w, acc->w * f, acc->w, f);
 		return -1;
 	}
 	if (oy > y0 * f || oy + img->h < (y1 + 1) * f) {
@@ -284,8 +336,9 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 		return -1;
 	}
 	const int ch[3] = { ir, ig, ib };
-	if (s == ACC_AA) {
-		long c = merge_aa(acc, img, oy, ch, x0, y0, x1, y1, pass);
+	if (s == ACC_AA || grid) {
+		long c = grid ? merge_grid(acc, img, oy, ch, s, x0, y0, x1, y1, pass)
+			      : merge_aa(acc, img, oy, ch, x0, y0, x1, y1, pass);
 		if (folded)
 			*folded = c;
 		return 0;
@@ -337,7 +390,14 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 	int oy = 0;
 	if (folded)
 		*folded = 0;
-	const int f = accum_render_factor(s);
+	int f = accum_render_factor(s);
+	if (s >= 4) {	/* a grid render or not: the render's width says */
+		if (image_read_exr_rows(path, 0, 0, &img, &oy, err, errlen))
+			return -1;
+		if (img.w == acc->w * ACC_GRID_FRAME)
+			f = ACC_GRID_FRAME;
+		image_release(&img);
+	}
 	int rc = image_read_exr_rows(path, y0 * f, (y1 + 1) * f - 1, &img, &oy, err, errlen) ||
 		 accum_merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, folded, err, errlen);
 	image_release(&img);

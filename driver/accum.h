@@ -29,7 +29,8 @@
  * pixel positions.  The grids of scales 1, 2, 4, 8 and 16 share no
  * position, so their samples are new information even for a scene without
  * any randomness; a scale already in a pixel's mask would repeat positions
- * it has, and is skipped.
+ * it has, and is skipped.  A grid render (ACC_GRID_FRAME, below) samples
+ * the same s x s cells, jittered inside them.
  */
 #ifndef POVPRESS_ACCUM_H
 #define POVPRESS_ACCUM_H
@@ -58,6 +59,29 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
 static inline int accum_render_factor(int s)
 {
 	return s == ACC_AA ? 1 : s;
+}
+
+/*
+ * A grid render of scale s (4, 8 or 16): the region at twice the image's
+ * size (ACC_GRID_FRAME) with POV-Ray's non-adaptive antialiasing,
+ * +AM1 +A0.0 +R(s/2) +J0.5, which with a threshold of 0 supersamples
+ * every pixel of the render with an s/2 x s/2 grid of samples, each
+ * jittered inside its cell, besides the one at its centre.  (Full jitter,
+ * +J, moves samples up to a whole cell, out of the pixel: a wider filter
+ * than the pixel's box, which at hdr_highlights' lamps made the error 4
+ * times scale 8's.)  A pixel so gets accum_grid_samples(s) = s^2 + 4
+ * samples: an s x s jittered grid and the 4 positions of scale 2 again.
+ * POV-Ray holds and writes its whole frame, whose cost grows with the
+ * frame's size whatever the region's (at 640x480, scale 8 writes a
+ * 5120x3840 frame for about 1.5 CPU seconds), so a grid render costs what
+ * its samples cost.  Its pixels come as 4 means, not as samples; see
+ * accum_merge_region().
+ */
+#define ACC_GRID_FRAME 2
+
+static inline int accum_grid_samples(int s)
+{
+	return 4 * ((s / 2) * (s / 2) + 1);
 }
 
 /* From this finest scale on, a pixel's fold differences are its whole
@@ -95,15 +119,21 @@ int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
  * Fold a region render at scale s into acc: img holds rows oy.. of the
  * s*W x s*H render (as image_read_exr_rows() returns them), and the
  * pixels of rectangle x0..x1, y0..y1 (inclusive, in acc's pixels) take the
- * mean of their s x s blocks.  *folded counts the pixels that took new
- * samples (may be NULL).  Fails on a size mismatch or rows not read.
+ * mean of their s x s blocks.  A render twice the image's size at scale 4
+ * or more is a grid render (ACC_GRID_FRAME): its 2 x 2 blocks are means of
+ * s^2 / 4 + 1 samples each; the pixel takes their mean, the spread between
+ * them, and within them the per-sample spread their spread implies for
+ * noise, but not more than the pixel's samples had so far (spread between
+ * the sub-pixels can be an edge's, not noise).  *folded counts the pixels
+ * that took new samples (may be NULL).  Fails on a size mismatch or rows
+ * not read.
  */
 int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
 		       int y0, int x1, int y1, int pass, long *folded, char *err,
 		       size_t errlen);
 
 /* The same from the render's file at path, reading only the rows the
- * rectangle needs. */
+ * rectangle needs (the render's size is read from the file first). */
 int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
 		     int y1, int pass, long *folded, char *err, size_t errlen);
 

@@ -343,7 +343,8 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	/* POV-Ray holds a region render's whole s W x s H frame in memory and
 	 * writes it out, so the scale is capped by the frame's size */
 	int smax = 16;
-	while (smax > 2 && (double)smax * smax * w * h > PLAN_MAX_FRAME)
+	while (smax > 2 && (double)smax * smax * w * h > PLAN_MAX_FRAME &&
+	       !(p->grid && smax >= 4))
 		smax /= 2;
 	size_t nc = 0;
 	for (size_t i = 0; i < npx; i++) {
@@ -425,6 +426,8 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 		goto out;
 	}
 	qsort(out->regions, out->nregions, sizeof(*out->regions), by_position);
+	for (size_t k = 0; k < out->nregions; k++)
+		out->regions[k].frame = p->grid && out->regions[k].scale >= 4 ? ACC_GRID_FRAME : 0;
 
 	/* what the kept regions do */
 	double gained = 0.0;
@@ -475,7 +478,8 @@ void plan_release(struct plan *pl)
 void plan_job(const struct pov_job *base, const struct plan_region *r, const char *output,
 	      struct pov_region *region, const char **extra, struct pov_job *job)
 {
-	int s = accum_render_factor(r->scale);
+	const int grid = r->frame == ACC_GRID_FRAME && r->scale >= 4;
+	int s = grid ? ACC_GRID_FRAME : accum_render_factor(r->scale);
 	*job = *base;
 	job->output = output;
 	job->width = base->width * s;
@@ -495,6 +499,12 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 		extra[job->nextra++] = "+A0.0";
 		extra[job->nextra++] = "+R4";
 		extra[job->nextra++] = "+J";
+	} else if (grid) {
+		/* every pixel of the 2x render supersampled (accum.h) */
+		extra[job->nextra++] = "+AM1";
+		extra[job->nextra++] = "+A0.0";
+		extra[job->nextra++] = r->scale == 4 ? "+R2" : r->scale == 8 ? "+R4" : "+R8";
+		extra[job->nextra++] = "+J0.5";
 	} else {
 		extra[job->nextra++] = "-A";	/* our samples are the s x s grid */
 	}

@@ -16,7 +16,8 @@
  * area x s^2 samples.  Every pixel of a rectangle gets the new samples,
  * chosen or not.  POV-Ray renders a region into a whole s W x s H frame, so
  * scales whose frame would exceed 32 Mpixels are not used (at 640x480 the
- * largest scale is 8, at 1920x1080 it is 4).
+ * largest scale is 8, at 1920x1080 it is 4); grid renders, twice the
+ * image's size, have no such cap.
  */
 #ifndef POVPRESS_PLAN_H
 #define POVPRESS_PLAN_H
@@ -37,6 +38,8 @@ struct plan_params {
 	int tile;		/* packing grid in pixels (default 8) */
 	double min_gain;	/* a pixel gaining less than min_gain * target
 				 * is not refined (default 0.05) */
+	int grid;		/* scales 4, 8, 16 as grid renders (accum.h;
+				 * default 0: resolution scaling) */
 };
 
 void plan_params_init(struct plan_params *p);
@@ -47,6 +50,9 @@ struct plan_region {
 	long chosen;		/* chosen pixels inside */
 	double gain;		/* predicted reduction of the summed error */
 	double cost;		/* predicted cost, seconds */
+	int frame;		/* the render's size over the image's: 0 for
+				 * accum_render_factor(scale), or ACC_GRID_FRAME
+				 * for a grid render */
 };
 
 enum plan_outcome {
@@ -94,8 +100,10 @@ void plan_release(struct plan *pl);
 
 /*
  * The POV-Ray job for region r of a plan, rendering into output: the
- * region at r->scale times base, with antialiasing off, or at scale 1 with
- * POV-Ray's antialiasing when r->scale is ACC_AA (the options appended
+ * region at r->scale times base, with antialiasing off, at twice base with
+ * +AM1 +A0.0 +R(scale/2) +J0.5 for a grid render (r->frame ACC_GRID_FRAME),
+ * or at scale 1 with POV-Ray's antialiasing when r->scale is ACC_AA (the
+ * options appended
  * after the user's, which come from base->extra).  base gives the scene,
  * full size, threads, defines, extra options, work directory and binary;
  * the job borrows region (storage for the scaled rectangle) and extra

@@ -25,7 +25,8 @@ static const char plan_usage[] =
 	"usage: povpress plan ANALYSIS.exr --scene SCENE.pov -o DIR [--state ACCUM.exr]\n"
 	"                     [--pass N] [--target RELMSE] [--budget SECONDS]\n"
 	"                     [--cost-job SECONDS] [--cost-sample SECONDS]\n"
-	"                     [--max-regions N] [--threads N] [--radiosity FILE]\n"
+	"                     [--max-regions N] [--sampler grid|scale] [--threads N]\n"
+	"                     [--radiosity FILE]\n"
 	"                     [-- POVRAY_OPTIONS...]\n"
 	"\n"
 	"Decide which pixels need more samples and write, into DIR:\n"
@@ -51,7 +52,10 @@ static const char plan_usage[] =
 	"  --cost-job S        cost of one POV-Ray run (default 0.05; 'render' measures\n"
 	"                      it on the base pass and reports it)\n"
 	"  --cost-sample S     cost of one sample (default 2e-6; measured likewise)\n"
-	"  --max-regions N     at most N rectangles (default 16)\n"
+	"  --max-regions N     at most N rectangles (default 8)\n"
+	"  --sampler S         how scales 4, 8 and 16 are rendered, as in 'render': grid\n"
+	"                      (default: twice the size with +AM1 +A0.0 +R(scale/2)\n"
+	"                      +J0.5) or scale (scale times the size, no antialiasing)\n"
 	"  --threads N         POV-Ray threads per job, +WT (default 1)\n"
 	"  --radiosity FILE    radiosity data the base pass saved (+RFO): jobs load it\n"
 	"  -- OPTIONS          passed to every POV-Ray job (as given to the base pass)\n"
@@ -118,7 +122,8 @@ int cmd_plan(int argc, char **argv)
 	int pass = 1, threads = 1;
 	struct plan_params pp;
 	plan_params_init(&pp);
-	pp.max_regions = 16;
+	pp.max_regions = 8;
+	pp.grid = 1;
 	int i = 1;
 	for (; i < argc; i++) {
 		const char *a = argv[i];
@@ -147,6 +152,15 @@ int cmd_plan(int argc, char **argv)
 		} else if (!strcmp(a, "--threads")) {
 			if (args_int(argv[++i], 1, 1024, &threads))
 				goto bad;
+		} else if (!strcmp(a, "--sampler")) {
+			const char *m = argv[++i];
+			if (!strcmp(m, "grid") || !strcmp(m, "scale")) {
+				pp.grid = !strcmp(m, "grid");
+			} else {
+				fprintf(stderr, "povpress plan: --sampler takes grid or scale, not '%s'\n",
+					m);
+				return 2;
+			}
 		} else if (!strcmp(a, "--max-regions")) {
 			if (args_int(argv[++i], 1, 100000, &pp.max_regions))
 				goto bad;

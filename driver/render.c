@@ -41,16 +41,16 @@ static const char usage[] =
 	"                       [--workdir DIR] [--keep-workdir] [--resume]\n"
 	"                       [--error-map FILE] [--report FILE.json]\n"
 	"                       [--final auto|samples|reconstruction] [--radiosity-scale K]\n"
-	"                       [--sampler scale|aa]\n"
+	"                       [--sampler scale|grid|aa]\n"
 	"                       [-q|-v]\n"
 	"                       [-- POVRAY_OPTIONS...]\n"
 	"\n"
 	"Render SCENE.pov through POV-Ray adaptively: a base pass at one sample per\n"
 	"pixel, then passes that estimate every pixel's error by local regression\n"
-	"(PRESS) and re-render only the regions worth it at 2, 4, 8 and 16 times the\n"
-	"resolution (4 to 256 new samples per pixel), until the estimated image relMSE\n"
-	"reaches the target, the budget is spent, the passes run out, or no pixel\n"
-	"would gain.\n"
+	"(PRESS) and re-render only the regions worth it at scales 2, 4, 8 and 16\n"
+	"(4, then about 16, 64 and 256 new samples per pixel), until the estimated\n"
+	"image relMSE reaches the target, the budget is spent, the passes run out, or\n"
+	"no pixel would gain.\n"
 	"\n"
 	"options:\n"
 	"  -o, --output FILE     final image, float RGB EXR (required)\n"
@@ -77,12 +77,15 @@ static const char usage[] =
 	"  --error-map FILE      error map EXR (default OUT.errors.exr): error,\n"
 	"                        relerror, samples, order, bandwidth, pass, scales\n"
 	"  --report FILE         JSON report of every pass (default: none)\n"
-	"  --sampler S           how pixels with 21+ samples get more: scale (default:\n"
-	"                        resolution scaling, 64 then 256 samples) or aa (first,\n"
-	"                        once per pixel, POV-Ray's antialiasing, +AM2 +A0 +R4 +J,\n"
-	"                        weighted by what it proves worth, then scaling; better\n"
-	"                        on soft shadows and thin geometry, worse under focal\n"
-	"                        blur and glossy reflection: see the README)\n"
+	"  --sampler S           how pixels get their samples: grid (default: scales 4,\n"
+	"                        8 and 16 as renders at twice the size with POV-Ray's\n"
+	"                        +AM1 +A0.0 +R(scale/2) +J0.5, scale x scale jittered\n"
+	"                        samples), scale (resolution scaling throughout: the\n"
+	"                        render is scale times the size, which POV-Ray pays for\n"
+	"                        per render whatever the region), or aa (scaling, and\n"
+	"                        for pixels with 21+ samples first, once per pixel,\n"
+	"                        POV-Ray's antialiasing, +AM2 +A0 +R4 +J, weighted by\n"
+	"                        what it proves worth); see the README\n"
 	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
 	"                        pixel's samples; default), auto (the sample mean or the\n"
 	"                        regression's fit, whichever is predicted closer), or\n"
@@ -154,8 +157,8 @@ struct run {
 	int pool_done, pool_total, pool_pass;
 };
 
-enum { SAMPLER_SCALE, SAMPLER_AA, NSAMPLERS };
-static const char *const sampler_names[NSAMPLERS] = { "scale", "aa" };
+enum { SAMPLER_SCALE, SAMPLER_AA, SAMPLER_GRID, NSAMPLERS };
+static const char *const sampler_names[NSAMPLERS] = { "scale", "aa", "grid" };
 
 static void progress(struct run *r, const char *fmt, ...)
 	__attribute__((format(printf, 2, 3)));
@@ -630,14 +633,13 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	/* The plan depends on these only through their sizes, and timing noise
 	 * must not change it from run to run (--jobs 1 -- +WT1 is meant to be
 	 * reproducible): the per-sample and setup costs are rounded to powers
-	 * of two, the latency to 0.7 s times a power of two (it measures 0.65
-	 * to 0.75 s here, well inside one step). */
+	 * of two. */
 	r->cost_sample = quantise(r->cost_sample, 1.0);
-	double lat = quantise(r->latency > 0.01 ? r->latency : 0.01, 0.7);
-	/* a region render repeats the setup (parse, bounding) and waits on
-	 * POV-Ray's latency in one of the pool's slots: in core-seconds that
-	 * is the latency times cores over slots */
-	r->cost_job = (setup > 1e-3 ? quantise(setup, 1.0) : 0.0) + lat * r->cores / r->jobs;
+	/* a region render repeats the setup (parse, bounding, writing its
+	 * frame): that is its cost.  It also waits on POV-Ray's latency, but
+	 * asleep, and a pass of at most --jobs regions (the planner's cap) waits
+	 * on it once whatever their number. */
+	r->cost_job = setup > 0.01 ? quantise(setup, 1.0) : 0.01;
 	if (r->user_cost_job > 0.0)
 		r->cost_job = r->user_cost_job;
 	if (r->user_cost_sample > 0.0)
@@ -709,8 +711,10 @@ static void choose_samplers(const struct run *r, struct plan *pl)
 		memmove(pl->regions + m + 1, pl->regions + m, (k - m) * sizeof(g));
 		pl->regions[m++] = g;
 	}
-	for (size_t k = m; k < pl->nregions; k++)
+	for (size_t k = m; k < pl->nregions; k++) {
 		pl->regions[k].scale = ACC_AA;
+		pl->regions[k].frame = 0;
+	}
 }
 
 /*
@@ -727,7 +731,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	pp.target = r->target;
 	pp.cost_job = r->cost_job;
 	pp.cost_sample = r->cost_sample;
-	pp.max_regions = 4 * r->jobs > 16 ? 4 * r->jobs : 16;
+	pp.max_regions = r->jobs > 8 ? r->jobs : 8;
+	pp.grid = r->sampler == SAMPLER_GRID;
 	if (r->budget > 0.0) {
 		double left = r->budget - elapsed(r);
 		/* in core-seconds, keeping a share for the analysis and the
@@ -836,7 +841,9 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		}
 		p.regions++;
 		p.pixels += folded;
-		p.samples += s == ACC_AA ? 0.0 : (double)folded * s * s;
+		p.samples += s == ACC_AA ? 0.0
+					 : (double)folded * (g->frame == ACC_GRID_FRAME ? accum_grid_samples(s)
+											: s * s);
 		if (!r->keep)
 			unlink(outs[k]);
 	}
@@ -911,7 +918,7 @@ int cmd_render(int argc, char **argv)
 	r.final = ACC_FINAL_SAMPLES;
 	r.rad_scale = 1;
 	r.user_rad_scale = -1;
-	r.sampler = SAMPLER_SCALE;
+	r.sampler = SAMPLER_GRID;
 	char emap[PATH_MAX], wdir[PATH_MAX];
 
 	int i = 1;

@@ -181,14 +181,14 @@ else
 	bad "radiosity_room: reference render failed"
 fi
 
-# --- --sampler: POV-Ray's antialiasing for pixels with 21+ samples ----------
+# --- --sampler: grid renders, resolution scaling, POV-Ray's antialiasing ----
 msg=$("$PP" render "$SC/smooth_empty.pov" -o "$T/x.exr" --sampler jitter 2>&1)
 rc=$?
-check "render with --sampler jitter (not scale or aa) is a usage error (2)" test $rc -eq 2
+check "render with --sampler jitter (not grid, scale or aa) is a usage error (2)" test $rc -eq 2
 check "... whose message names the option" grep -q -- "--sampler" <<<"$msg"
 scene="$SC/soft_shadows.pov"
 if ref=$(reference "$scene"); then
-	for m in scale aa; do
+	for m in scale aa grid; do
 		"$PP" render "$scene" -o "$T/smp-$m.exr" -W $W -H $H --target 3e-4 --sampler $m -q \
 			--keep-workdir --report "$T/smp-$m.json" -- +WT1 ||
 			bad "--sampler $m: render failed"
@@ -204,6 +204,18 @@ if ref=$(reference "$scene"); then
 	# (measured 2.5e-5 both ways; a fold that trusted the antialiased render
 	# beyond what it proved worth was 5.5e-3)
 	check "--sampler aa: relMSE at most twice --sampler scale's" num 'a <= 2 * b' "$aa" "$sc"
+	gr=$(relmse "$T/smp-grid.exr" "$ref")
+	echo "# ... and $gr with --sampler grid"
+	check "--sampler grid: the report says so" grep -q '"sampler": "grid"' "$T/smp-grid.json"
+	# a grid render is twice the image's size whatever its scale; scaling's
+	# scale-4 render is four times
+	g4=$(compgen -G "$T/smp-grid.exr.work/p*-s4.exr" | head -n 1)
+	s4=$(compgen -G "$T/smp-scale.exr.work/p*-s4.exr" | head -n 1)
+	check "--sampler grid: a scale-4 region rendered at twice the width" \
+		grep -q "$((2 * W)) x *$((2 * H))" <(iinfo "$g4" 2>&1)
+	check "--sampler scale: at four times the width" \
+		grep -q "$((4 * W)) x *$((4 * H))" <(iinfo "$s4" 2>&1)
+	check "--sampler grid: relMSE at most twice --sampler scale's" num 'a <= 2 * b' "$gr" "$sc"
 else
 	bad "soft_shadows: reference render failed"
 fi
@@ -213,7 +225,7 @@ fi
 px=$(awk '/"pass": [1-9]/ { for (i = 1; i <= NF; i++) if ($i == "\"pixels\":") s += $(i + 1) }
 	END { print s + 0 }' "$T/smooth.json")
 check "smooth scene: at most 2% of the pixels re-rendered ($px)" num 'a <= 0.02 * b' "$px" $((W * H))
-check "--sampler scale is the default" grep -q '"sampler": "scale"' "$T/smooth.json"
+check "--sampler grid is the default" grep -q '"sampler": "grid"' "$T/smooth.json"
 
 # --- determinism: one job, one POV-Ray thread -------------------------------
 for k in 1 2; do
@@ -248,6 +260,21 @@ check "plan's regions are render's regions" \
 oiiotool "$T/farm/acc1.exr" --ch R,G,B -o "$T/farm/img1.exr" 2>/dev/null
 check "plan -> xargs -> merge gives render's image, bit for bit" \
 	idiff -fail 0 -failpercent 0 "$T/farm/img1.exr" "$T/one.exr" >/dev/null
+
+# --- merge folds grid renders (scale 4 and up) as render does ---------------
+gm=(render "$scene" -o "$T/gm.exr" -W 48 -H 36 --jobs 1 --target 1e-4 -q --keep-workdir
+	--workdir "$T/gm.work")
+"$PP" "${gm[@]}" --max-passes 1 -- +WT1 && cp "$T/gm.work/accum.exr" "$T/gm-acc1.exr" &&
+	"$PP" "${gm[@]}" --max-passes 2 --resume -- +WT1 &&
+	"$PP" merge "$T/gm-acc1.exr" "$T/gm.work/regions.tsv" -o "$T/gm-acc2.exr" >/dev/null
+check "render, --resume a pass further, merge its regions.tsv: runs" test $? -eq 0
+check "... the pass rendered a grid region (scale 4)" \
+	awk -F'\t' '$1 == 2 && $6 == 4 { f = 1 } END { exit !f }' "$T/gm.work/regions.tsv"
+for f in gm-acc2 gm.work/accum; do
+	oiiotool "$T/$f.exr" --ch R,G,B,samples,var.R,diff -o "$T/${f//\//-}-ch.exr" 2>/dev/null
+done
+check "... merge folds it to render's accumulation, bit for bit" \
+	idiff -fail 0 -failpercent 0 "$T/gm-acc2-ch.exr" "$T/gm.work-accum-ch.exr"
 
 # --- a region job that crashes or hangs: retried, reported, image valid -----
 cat >"$T/fakepov" <<'EOF'

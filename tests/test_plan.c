@@ -239,6 +239,110 @@ static int expected_pixel(int x, int y, const struct image *r2, int oy2, const i
 	return n;
 }
 
+/*
+ * accum_merge_region of a grid render (twice the image's width at scale 4
+ * or more): a pixel takes s^2 + 4 samples, the mean of its 4 sub-pixels,
+ * their spread and the within spread it implies (capped by the pixel's own
+ * sample variance); a sub-pixel that is not finite is left out; the scale
+ * is taken once; a width that fits neither way is an error naming both.
+ */
+static void test_merge_grid(void **state)
+{
+	const int W = 6, H = 4;
+	struct image acc, r2, g, bad;
+	char err[256];
+	long folded = -1;
+
+	(void)state;
+	make_acc(&acc, W, H, base_value);
+	make_render(&r2, 2 * W, 0, 2 * H, 2);
+	assert_int_equal(accum_merge_region(&acc, &r2, 0, 2, 0, 0, W - 1, H - 1, 1, &folded, err,
+					    sizeof(err)), 0);
+	make_render(&g, 2 * W, 0, 2 * H, 7);
+	/* one sub-pixel of pixel (4, 2) not finite; pixel (1, 1) flat inside
+	 * (its sub-pixels equal), so the cap and the spread are both seen */
+	g.px[((size_t)(2 * 2) * g.w + 2 * 4 + 1) * 3 + 1] = NAN;
+	for (int j = 0; j < 2; j++)
+		for (int l = 0; l < 2; l++)
+			for (int k = 0; k < 3; k++)
+				g.px[((size_t)(2 + j) * g.w + 2 + l) * 3 + k] = 0.4f;
+	size_t npx = (size_t)W * H, bytes = npx * ACC_NCH * sizeof(float);
+	float *before = malloc(bytes);
+	assert_non_null(before);
+	memcpy(before, acc.px, bytes);
+	assert_int_equal(accum_merge_region(&acc, &g, 0, 8, 1, 1, 4, 2, 2, &folded, err,
+					    sizeof(err)), 0);
+	assert_int_equal(folded, 8);
+	const double gs = 17.0;	/* samples per sub-pixel at scale 8: 4 x 4 + 1 */
+	for (int y = 0; y < H; y++)
+		for (int x = 0; x < W; x++) {
+			size_t i = (size_t)y * W + x;
+			const float *o = accpx(&acc, i), *b = before + i * ACC_NCH;
+			char what[64];
+			if (x < 1 || x > 4 || y < 1 || y > 2) {
+				assert_memory_equal(o, b, ACC_NCH * sizeof(float));
+				continue;
+			}
+			double sub[4][3];
+			int nq = 0;
+			for (int j = 0; j < 2; j++)
+				for (int l = 0; l < 2; l++) {
+					if (x == 4 && y == 2 && j == 0 && l == 1)
+						continue;
+					for (int c = 0; c < 3; c++)
+						sub[nq][c] = render_at(&g, 0, 2 * x + l, 2 * y + j, c);
+					nq++;
+				}
+			double na = b[ACC_SAMPLES], nb = nq * gs, nt = na + nb;
+			assert_true(o[ACC_SAMPLES] == (float)nt);
+			assert_true(o[ACC_SCALES] == (float)(2 + 4 + 256));
+			assert_true(o[ACC_PASS] == 2.0f);
+			for (int c = 0; c < 3; c++) {
+				double m = 0.0, bsum = 0.0;
+				for (int q = 0; q < nq; q++)
+					m += sub[q][c] / nq;
+				for (int q = 0; q < nq; q++)
+					bsum += (sub[q][c] - m) * (sub[q][c] - m);
+				double v = gs * bsum / (nq - 1);
+				if (b[ACC_VAR_R + c] < v)
+					v = b[ACC_VAR_R + c];
+				double m2b = gs * bsum + nq * (gs - 1.0) * v;
+				double d = m - b[c];
+				double mt = b[c] + d * nb / nt;
+				double vt = ((double)b[ACC_VAR_R + c] * (na - 1.0) + m2b +
+					     d * d * na * nb / nt) / (nt - 1.0);
+				snprintf(what, sizeof(what), "(%d,%d) c%d mean", x, y, c);
+				assert_close(o[c], mt, 1e-6, 0.0, what);
+				snprintf(what, sizeof(what), "(%d,%d) c%d variance", x, y, c);
+				assert_close(o[ACC_VAR_R + c], vt, 1e-5, 1e-12, what);
+				if (x == 1 && y == 1)	/* no spread inside: only the fold's */
+					assert_close(o[ACC_VAR_R + c],
+						     ((double)b[ACC_VAR_R + c] * (na - 1.0) +
+						      d * d * na * nb / nt) / (nt - 1.0),
+						     1e-5, 1e-12, what);
+			}
+		}
+	/* the same scale again: nothing */
+	memcpy(before, acc.px, bytes);
+	assert_int_equal(accum_merge_region(&acc, &g, 0, 8, 1, 1, 4, 2, 3, &folded, err,
+					    sizeof(err)), 0);
+	assert_int_equal(folded, 0);
+	assert_memory_equal(before, acc.px, bytes);
+	/* three times the width at scale 8: neither 8 x W nor a grid render */
+	make_render(&bad, 3 * W, 0, 3 * H, 8);
+	err[0] = '\0';
+	assert_int_equal(accum_merge_region(&acc, &bad, 0, 8, 0, 0, 1, 1, 3, &folded, err,
+					    sizeof(err)), -1);
+	assert_non_null(strstr(err, "48"));
+	assert_non_null(strstr(err, "12 (a grid render)"));
+	assert_memory_equal(before, acc.px, bytes);
+	image_release(&bad);
+	free(before);
+	image_release(&g);
+	image_release(&r2);
+	image_release(&acc);
+}
+
 /* 2. accum_merge_region: block statistics, untouched outside, errors. */
 static void test_merge_region(void **state)
 {
@@ -772,9 +876,9 @@ static void test_plan_make(void **state)
 static void test_regions_file(void **state)
 {
 	struct plan_region rs[3] = {
-		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1 },
-		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2 },
-		{ 63, 47, 63, 47, 16, 1, 0.1, 0.3 },
+		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1, 0 },
+		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2, 0 },
+		{ 63, 47, 63, 47, 16, 1, 0.1, 0.3, 0 },
 	};
 	static char o0[] = "r0.exr", o1[] = "a dir/with spaces/region 1.exr",
 		o2[] = "/tmp/x y  z.exr";
@@ -837,7 +941,7 @@ static void test_plan_job(void **state)
 {
 	static const char *const base_extra[] = { "+Q9", "Antialias_Threshold=0.1" };
 	struct pov_job base, job;
-	struct plan_region r = { 3, 2, 10, 7, 4, 0, 0.0, 0.0 };
+	struct plan_region r = { 3, 2, 10, 7, 4, 0, 0.0, 0.0, 0 };
 	struct pov_region region;
 	const char *extra[3];
 
@@ -887,6 +991,32 @@ static void test_plan_job(void **state)
 	assert_string_equal(name, "w/p03-r007-aa.exr");
 	plan_output_name(name, sizeof(name), "w", 3, 7, 8);
 	assert_string_equal(name, "w/p03-r007-s8.exr");
+
+	/* a grid region: twice the size whatever the scale, every pixel
+	 * supersampled on a (scale/2)^2 grid jittered inside its cells */
+	for (int s = 4; s <= 16; s *= 2) {
+		r.scale = s;
+		r.frame = ACC_GRID_FRAME;
+		plan_job(&base, &r, "out/g.exr", &region, aextra, &job);
+		assert_int_equal(job.width, 128);
+		assert_int_equal(job.height, 96);
+		assert_int_equal(region.x0, 6);
+		assert_int_equal(region.y0, 4);
+		assert_int_equal(region.x1, 21);
+		assert_int_equal(region.y1, 15);
+		assert_int_equal(job.nextra, 6);
+		assert_string_equal(job.extra[2], "+AM1");
+		assert_string_equal(job.extra[3], "+A0.0");
+		assert_string_equal(job.extra[4], s == 4 ? "+R2" : s == 8 ? "+R4" : "+R8");
+		assert_string_equal(job.extra[5], "+J0.5");
+		assert_int_equal(accum_grid_samples(s), s * s + 4);
+	}
+	/* scale 2 stays a plain render at twice the size */
+	r.scale = 2;
+	plan_job(&base, &r, "out/t.exr", &region, aextra, &job);
+	assert_int_equal(job.width, 128);
+	assert_int_equal(job.nextra, 3);
+	assert_string_equal(job.extra[2], "-A");
 }
 
 int main(void)
@@ -896,6 +1026,7 @@ int main(void)
 		cmocka_unit_test(test_merge_region),
 		cmocka_unit_test(test_merge_nonfinite),
 		cmocka_unit_test(test_merge_aa),
+		cmocka_unit_test(test_merge_grid),
 		cmocka_unit_test(test_accum_read),
 		cmocka_unit_test(test_read_rows),
 		cmocka_unit_test(test_plan_make),
