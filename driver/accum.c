@@ -254,7 +254,7 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 static long merge_grid(struct image *acc, const struct image *img, int oy, const int ch[3],
 		       int s, int x0, int y0, int x1, int y1, int pass)
 {
-	const int f = ACC_GRID_FRAME, g = accum_grid_samples(s) / 4;	/* per sub-pixel */
+	const int f = ACC_GRID_FRAME, g0 = accum_grid_samples(s) / 4;	/* per sub-pixel */
 	long count = 0;
 	for (int y = y0; y <= y1; y++)
 		for (int x = x0; x <= x1; x++) {
@@ -262,6 +262,10 @@ static long merge_grid(struct image *acc, const struct image *img, int oy, const
 			const float *o = acc->px + i * ACC_NCH;
 			double sub[4][3], mean[3] = { 0.0, 0.0, 0.0 }, m2[3];
 			int nq = 0;
+			/* a sub-pixel's centre sample repeats scale 2's where the
+			 * pixel has it: taken out, by the pixel's mean in its place */
+			const int dup = accum_has_scale(acc, i, 2) && o[ACC_SAMPLES] > 0.0f;
+			const int g = dup ? g0 - 1 : g0;
 			for (int j = 0; j < f; j++)
 				for (int l = 0; l < f; l++) {
 					const float *p = img->px +
@@ -271,8 +275,9 @@ static long merge_grid(struct image *acc, const struct image *img, int oy, const
 					    !isfinite(p[ch[2]]))
 						continue;
 					for (int c = 0; c < 3; c++) {
-						sub[nq][c] = p[ch[c]];
-						mean[c] += p[ch[c]];
+						sub[nq][c] = dup ? (g0 * (double)p[ch[c]] - o[c]) / g
+								 : p[ch[c]];
+						mean[c] += sub[nq][c];
 					}
 					nq++;
 				}

@@ -64,13 +64,19 @@ static inline int accum_render_factor(int s)
 /*
  * A grid render of scale s (4, 8 or 16): the region at twice the image's
  * size (ACC_GRID_FRAME) with POV-Ray's non-adaptive antialiasing,
- * +AM1 +A0.0 +R(s/2) +J0.5, which with a threshold of 0 supersamples
- * every pixel of the render with an s/2 x s/2 grid of samples, each
- * jittered inside its cell, besides the one at its centre.  (Full jitter,
- * +J, moves samples up to a whole cell, out of the pixel: a wider filter
- * than the pixel's box, which at hdr_highlights' lamps made the error 4
- * times scale 8's.)  A pixel so gets accum_grid_samples(s) = s^2 + 4
- * samples: an s x s jittered grid and the 4 positions of scale 2 again.
+ * +AM1 +A0.0 +R(s/2) +J0.5, which with a threshold of 0 supersamples every
+ * pixel of the render with an s/2 x s/2 grid of samples, each jittered
+ * inside its cell, besides one at its centre.  A pixel so gets
+ * accum_grid_samples(s) = s^2 + 4 samples: an s x s jittered grid, and the
+ * 4 positions of scale 2 again.  Where the pixel has had scale 2 those 4
+ * repeat samples it has (exactly, in a scene without randomness: counted
+ * twice they made the mean worse than its count and the fold difference
+ * smaller than the error; on glossy_reflection's micro-bumps the estimate
+ * fell to 0.6 of the true relMSE), so they are taken out, the pixel's mean
+ * standing in for them, and the pixel gets s^2 new samples.  (Full jitter, +J, moves samples up to a
+ * whole cell, out of the pixel: a wider filter than the pixel's box, which
+ * at hdr_highlights' lamps made the error 4 times scale 8's.  At the
+ * image's size, +R(s), the means under focal blur erred twice as much.)
  * POV-Ray holds and writes its whole frame, whose cost grows with the
  * frame's size whatever the region's (at 640x480, scale 8 writes a
  * 5120x3840 frame for about 1.5 CPU seconds), so a grid render costs what
@@ -121,7 +127,8 @@ int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
  * pixels of rectangle x0..x1, y0..y1 (inclusive, in acc's pixels) take the
  * mean of their s x s blocks.  A render twice the image's size at scale 4
  * or more is a grid render (ACC_GRID_FRAME): its 2 x 2 blocks are means of
- * s^2 / 4 + 1 samples each; the pixel takes their mean, the spread between
+ * s^2 / 4 + 1 samples each (s^2 / 4 where the pixel has scale 2: the
+ * centre sample out, see ACC_GRID_FRAME); the pixel takes their mean, the spread between
  * them, and within them the per-sample spread their spread implies for
  * noise, but not more than the pixel's samples had so far (spread between
  * the sub-pixels can be an edge's, not noise).  *folded counts the pixels

@@ -265,6 +265,12 @@ out:
 	return ret;
 }
 
+int plan_grid_scale(const struct plan_params *p, int w, int h, int s)
+{
+	return s >= 4 && (p->grid == PLAN_GRID_ALWAYS ||
+			  (p->grid == PLAN_GRID_LARGE && (double)s * s * w * h > PLAN_GRID_FRAME));
+}
+
 static int by_value(const void *a, const void *b)
 {
 	const struct plan_region *x = a, *y = b;
@@ -344,7 +350,7 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	 * writes it out, so the scale is capped by the frame's size */
 	int smax = 16;
 	while (smax > 2 && (double)smax * smax * w * h > PLAN_MAX_FRAME &&
-	       !(p->grid && smax >= 4))
+	       !plan_grid_scale(p, w, h, smax))
 		smax /= 2;
 	size_t nc = 0;
 	for (size_t i = 0; i < npx; i++) {
@@ -427,7 +433,8 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	}
 	qsort(out->regions, out->nregions, sizeof(*out->regions), by_position);
 	for (size_t k = 0; k < out->nregions; k++)
-		out->regions[k].frame = p->grid && out->regions[k].scale >= 4 ? ACC_GRID_FRAME : 0;
+		out->regions[k].frame = plan_grid_scale(p, w, h, out->regions[k].scale) ? ACC_GRID_FRAME
+											: 0;
 
 	/* what the kept regions do */
 	double gained = 0.0;
@@ -478,7 +485,7 @@ void plan_release(struct plan *pl)
 void plan_job(const struct pov_job *base, const struct plan_region *r, const char *output,
 	      struct pov_region *region, const char **extra, struct pov_job *job)
 {
-	const int grid = r->frame == ACC_GRID_FRAME && r->scale >= 4;
+	const int grid = r->frame > 0 && r->scale >= 4;
 	int s = grid ? ACC_GRID_FRAME : accum_render_factor(r->scale);
 	*job = *base;
 	job->output = output;
@@ -500,10 +507,11 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 		extra[job->nextra++] = "+R4";
 		extra[job->nextra++] = "+J";
 	} else if (grid) {
-		/* every pixel of the 2x render supersampled (accum.h) */
+		/* every pixel of the render supersampled (accum.h) */
 		extra[job->nextra++] = "+AM1";
 		extra[job->nextra++] = "+A0.0";
-		extra[job->nextra++] = r->scale == 4 ? "+R2" : r->scale == 8 ? "+R4" : "+R8";
+		int k = r->scale / s;
+		extra[job->nextra++] = k == 2 ? "+R2" : k == 4 ? "+R4" : "+R8";
 		extra[job->nextra++] = "+J0.5";
 	} else {
 		extra[job->nextra++] = "-A";	/* our samples are the s x s grid */

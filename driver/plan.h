@@ -38,9 +38,17 @@ struct plan_params {
 	int tile;		/* packing grid in pixels (default 8) */
 	double min_gain;	/* a pixel gaining less than min_gain * target
 				 * is not refined (default 0.05) */
-	int grid;		/* scales 4, 8, 16 as grid renders (accum.h;
-				 * default 0: resolution scaling) */
+	int grid;		/* which of scales 4, 8, 16 are grid renders
+				 * (accum.h): PLAN_GRID_* (default NEVER) */
 };
+
+/* Grid renders: never (resolution scaling), for every scale of 4 or more,
+ * or for those whose scaled frame would exceed PLAN_GRID_FRAME pixels. */
+enum { PLAN_GRID_NEVER, PLAN_GRID_ALWAYS, PLAN_GRID_LARGE };
+#define PLAN_GRID_FRAME (1024.0 * 1024.0)
+
+/* Whether scale s of a w x h image is rendered as a grid render. */
+int plan_grid_scale(const struct plan_params *p, int w, int h, int s);
 
 void plan_params_init(struct plan_params *p);
 
@@ -51,8 +59,8 @@ struct plan_region {
 	double gain;		/* predicted reduction of the summed error */
 	double cost;		/* predicted cost, seconds */
 	int frame;		/* the render's size over the image's: 0 for
-				 * accum_render_factor(scale), or ACC_GRID_FRAME
-				 * for a grid render */
+				 * accum_render_factor(scale), or
+				 * ACC_GRID_FRAME for a grid render */
 };
 
 enum plan_outcome {
@@ -101,7 +109,8 @@ void plan_release(struct plan *pl);
 /*
  * The POV-Ray job for region r of a plan, rendering into output: the
  * region at r->scale times base, with antialiasing off, at twice base with
- * +AM1 +A0.0 +R(scale/2) +J0.5 for a grid render (r->frame ACC_GRID_FRAME),
+ * twice base with +AM1 +A0.0 +R(scale/2) +J0.5 for a grid render (r->frame
+ * ACC_GRID_FRAME),
  * or at scale 1 with POV-Ray's antialiasing when r->scale is ACC_AA (the
  * options appended
  * after the user's, which come from base->extra).  base gives the scene,

@@ -25,7 +25,7 @@ static const char plan_usage[] =
 	"usage: povpress plan ANALYSIS.exr --scene SCENE.pov -o DIR [--state ACCUM.exr]\n"
 	"                     [--pass N] [--target RELMSE] [--budget SECONDS]\n"
 	"                     [--cost-job SECONDS] [--cost-sample SECONDS]\n"
-	"                     [--max-regions N] [--sampler grid|scale] [--threads N]\n"
+	"                     [--max-regions N] [--sampler auto|grid|scale] [--threads N]\n"
 	"                     [--radiosity FILE]\n"
 	"                     [-- POVRAY_OPTIONS...]\n"
 	"\n"
@@ -53,9 +53,11 @@ static const char plan_usage[] =
 	"                      it on the base pass and reports it)\n"
 	"  --cost-sample S     cost of one sample (default 2e-6; measured likewise)\n"
 	"  --max-regions N     at most N rectangles (default 8)\n"
-	"  --sampler S         how scales 4, 8 and 16 are rendered, as in 'render': grid\n"
-	"                      (default: twice the size with +AM1 +A0.0 +R(scale/2)\n"
-	"                      +J0.5) or scale (scale times the size, no antialiasing)\n"
+	"  --sampler S         how scales 4, 8 and 16 are rendered, as in 'render': auto\n"
+	"                      (default: grid where scaling's frame would exceed 1\n"
+	"                      Mpixel), grid (twice the size with +AM1 +A0.0\n"
+	"                      +R(scale/2) +J0.5) or scale (scale times the size, no\n"
+	"                      antialiasing)\n"
 	"  --threads N         POV-Ray threads per job, +WT (default 1)\n"
 	"  --radiosity FILE    radiosity data the base pass saved (+RFO): jobs load it\n"
 	"  -- OPTIONS          passed to every POV-Ray job (as given to the base pass)\n"
@@ -123,7 +125,7 @@ int cmd_plan(int argc, char **argv)
 	struct plan_params pp;
 	plan_params_init(&pp);
 	pp.max_regions = 8;
-	pp.grid = 1;
+	pp.grid = PLAN_GRID_LARGE;
 	int i = 1;
 	for (; i < argc; i++) {
 		const char *a = argv[i];
@@ -154,10 +156,15 @@ int cmd_plan(int argc, char **argv)
 				goto bad;
 		} else if (!strcmp(a, "--sampler")) {
 			const char *m = argv[++i];
-			if (!strcmp(m, "grid") || !strcmp(m, "scale")) {
-				pp.grid = !strcmp(m, "grid");
+			if (!strcmp(m, "auto")) {
+				pp.grid = PLAN_GRID_LARGE;
+			} else if (!strcmp(m, "grid")) {
+				pp.grid = PLAN_GRID_ALWAYS;
+			} else if (!strcmp(m, "scale")) {
+				pp.grid = PLAN_GRID_NEVER;
 			} else {
-				fprintf(stderr, "povpress plan: --sampler takes grid or scale, not '%s'\n",
+				fprintf(stderr,
+					"povpress plan: --sampler takes auto, grid or scale, not '%s'\n",
 					m);
 				return 2;
 			}

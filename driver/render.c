@@ -41,7 +41,7 @@ static const char usage[] =
 	"                       [--workdir DIR] [--keep-workdir] [--resume]\n"
 	"                       [--error-map FILE] [--report FILE.json]\n"
 	"                       [--final auto|samples|reconstruction] [--radiosity-scale K]\n"
-	"                       [--sampler scale|grid|aa]\n"
+	"                       [--sampler auto|grid|scale|aa]\n"
 	"                       [-q|-v]\n"
 	"                       [-- POVRAY_OPTIONS...]\n"
 	"\n"
@@ -50,7 +50,10 @@ static const char usage[] =
 	"(PRESS) and re-render only the regions worth it at scales 2, 4, 8 and 16\n"
 	"(4, then about 16, 64 and 256 new samples per pixel), until the estimated\n"
 	"image relMSE reaches the target, the budget is spent, the passes run out, or\n"
-	"no pixel would gain.\n"
+	"no pixel would gain.\n";
+
+/* (two strings: C11 promises no more than 4095 characters in one) */
+static const char usage_options[] =
 	"\n"
 	"options:\n"
 	"  -o, --output FILE     final image, float RGB EXR (required)\n"
@@ -77,15 +80,17 @@ static const char usage[] =
 	"  --error-map FILE      error map EXR (default OUT.errors.exr): error,\n"
 	"                        relerror, samples, order, bandwidth, pass, scales\n"
 	"  --report FILE         JSON report of every pass (default: none)\n"
-	"  --sampler S           how pixels get their samples: grid (default: scales 4,\n"
-	"                        8 and 16 as renders at twice the size with POV-Ray's\n"
-	"                        +AM1 +A0.0 +R(scale/2) +J0.5, scale x scale jittered\n"
-	"                        samples), scale (resolution scaling throughout: the\n"
-	"                        render is scale times the size, which POV-Ray pays for\n"
-	"                        per render whatever the region), or aa (scaling, and\n"
-	"                        for pixels with 21+ samples first, once per pixel,\n"
-	"                        POV-Ray's antialiasing, +AM2 +A0 +R4 +J, weighted by\n"
-	"                        what it proves worth); see the README\n"
+	"  --sampler S           how pixels get their samples: auto (default: grid for\n"
+	"                        the scales whose scaled frame would exceed 1 Mpixel,\n"
+	"                        scale below), grid (scales 4, 8 and 16 as renders at\n"
+	"                        twice the size with POV-Ray's +AM1 +A0.0 +R(scale/2)\n"
+	"                        +J0.5: scale x scale jittered samples), scale\n"
+	"                        (resolution scaling throughout: the render is scale\n"
+	"                        times the size, which POV-Ray pays for per render\n"
+	"                        whatever the region), or aa (scaling, and for pixels\n"
+	"                        with 21+ samples first, once per pixel, POV-Ray's\n"
+	"                        antialiasing, +AM2 +A0 +R4 +J, weighted by what it\n"
+	"                        proves worth); see the README\n"
 	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
 	"                        pixel's samples; default), auto (the sample mean or the\n"
 	"                        regression's fit, whichever is predicted closer), or\n"
@@ -157,8 +162,8 @@ struct run {
 	int pool_done, pool_total, pool_pass;
 };
 
-enum { SAMPLER_SCALE, SAMPLER_AA, SAMPLER_GRID, NSAMPLERS };
-static const char *const sampler_names[NSAMPLERS] = { "scale", "aa", "grid" };
+enum { SAMPLER_SCALE, SAMPLER_AA, SAMPLER_GRID, SAMPLER_AUTO, NSAMPLERS };
+static const char *const sampler_names[NSAMPLERS] = { "scale", "aa", "grid", "auto" };
 
 static void progress(struct run *r, const char *fmt, ...)
 	__attribute__((format(printf, 2, 3)));
@@ -732,7 +737,9 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	pp.cost_job = r->cost_job;
 	pp.cost_sample = r->cost_sample;
 	pp.max_regions = r->jobs > 8 ? r->jobs : 8;
-	pp.grid = r->sampler == SAMPLER_GRID;
+	pp.grid = r->sampler == SAMPLER_GRID   ? PLAN_GRID_ALWAYS
+		  : r->sampler == SAMPLER_AUTO ? PLAN_GRID_LARGE
+					       : PLAN_GRID_NEVER;
 	if (r->budget > 0.0) {
 		double left = r->budget - elapsed(r);
 		/* in core-seconds, keeping a share for the analysis and the
@@ -841,9 +848,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		}
 		p.regions++;
 		p.pixels += folded;
-		p.samples += s == ACC_AA ? 0.0
-					 : (double)folded * (g->frame == ACC_GRID_FRAME ? accum_grid_samples(s)
-											: s * s);
+		p.samples += s == ACC_AA ? 0.0 : (double)folded * s * s;
 		if (!r->keep)
 			unlink(outs[k]);
 	}
@@ -918,7 +923,7 @@ int cmd_render(int argc, char **argv)
 	r.final = ACC_FINAL_SAMPLES;
 	r.rad_scale = 1;
 	r.user_rad_scale = -1;
-	r.sampler = SAMPLER_GRID;
+	r.sampler = SAMPLER_AUTO;
 	char emap[PATH_MAX], wdir[PATH_MAX];
 
 	int i = 1;
@@ -930,6 +935,7 @@ int cmd_render(int argc, char **argv)
 			break;
 		} else if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
 			fputs(usage, stdout);
+			fputs(usage_options, stdout);
 			return 0;
 		} else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
 			r.quiet = 1;
@@ -940,8 +946,8 @@ int cmd_render(int argc, char **argv)
 		} else if (!strcmp(a, "--resume")) {
 			r.resume = 1;
 		} else if (!more && a[0] == '-') {
-			fprintf(stderr, "povpress render: unknown option or missing value '%s'\n%s", a,
-				usage);
+			fprintf(stderr, "povpress render: unknown option or missing value '%s'\n%s%s",
+				a, usage, usage_options);
 			return 2;
 		} else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
 			r.out = argv[++i];
@@ -1002,13 +1008,14 @@ int cmd_render(int argc, char **argv)
 			else
 				goto bad;
 		} else if (a[0] == '-' && a[1]) {
-			fprintf(stderr, "povpress render: unknown option '%s'\n%s", a, usage);
+			fprintf(stderr, "povpress render: unknown option '%s'\n%s%s", a, usage,
+				usage_options);
 			return 2;
 		} else if (!r.scene) {
 			r.scene = a;
 		} else {
 			fprintf(stderr, "povpress render: unexpected argument '%s' (POV-Ray options go "
-				"after --)\n%s", a, usage);
+				"after --)\n%s%s", a, usage, usage_options);
 			return 2;
 		}
 		continue;
@@ -1019,8 +1026,9 @@ bad:
 	r.extra = (const char *const *)argv + i;
 	r.nextra = (size_t)(argc - i);
 	if (!r.scene || !r.out) {
-		fprintf(stderr, "povpress render: %s\n%s",
-			!r.scene ? "no scene given" : "no output given (-o OUT.exr)", usage);
+		fprintf(stderr, "povpress render: %s\n%s%s",
+			!r.scene ? "no scene given" : "no output given (-o OUT.exr)", usage,
+			usage_options);
 		return 2;
 	}
 	if (!r.error_map) {

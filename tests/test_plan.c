@@ -240,16 +240,36 @@ static int expected_pixel(int x, int y, const struct image *r2, int oy2, const i
 }
 
 /*
- * accum_merge_region of a grid render (twice the image's width at scale 4
- * or more): a pixel takes s^2 + 4 samples, the mean of its 4 sub-pixels,
- * their spread and the within spread it implies (capped by the pixel's own
- * sample variance); a sub-pixel that is not finite is left out; the scale
- * is taken once; a width that fits neither way is an error naming both.
+ * What pixel b (an accumulation pixel before a fold) becomes when folded
+ * with nb samples of mean m and squared deviations m2: the pooled count,
+ * mean and variance.
+ */
+static void expect_fold(const float *b, double nb, const double m[3], const double m2[3],
+			double *n, double mean[3], double var[3])
+{
+	double na = b[ACC_SAMPLES];
+	*n = na + nb;
+	for (int c = 0; c < 3; c++) {
+		double d = m[c] - b[c];
+		mean[c] = b[c] + d * nb / *n;
+		var[c] = ((double)b[ACC_VAR_R + c] * (na - 1.0) + m2[c] + d * d * na * nb / *n) /
+			 (*n - 1.0);
+	}
+}
+
+/*
+ * accum_merge_region of grid renders, twice the image's width: 2 x 2
+ * sub-pixels of (s/2)^2 + 1 samples, less the centre one where the pixel
+ * has scale 2 (which it repeats), replaced by the pixel's mean (their mean, their spread and the
+ * within spread it implies, capped by the pixel's sample variance; a
+ * sub-pixel that is not finite left out), pooled with the pixel's samples
+ * (scale 16, then 8).  A scale is taken once; a width that fits neither
+ * way is an error naming both.
  */
 static void test_merge_grid(void **state)
 {
 	const int W = 6, H = 4;
-	struct image acc, r2, g, bad;
+	struct image acc, r2, g, g8, bad;
 	char err[256];
 	long folded = -1;
 
@@ -260,84 +280,92 @@ static void test_merge_grid(void **state)
 					    sizeof(err)), 0);
 	make_render(&g, 2 * W, 0, 2 * H, 7);
 	/* one sub-pixel of pixel (4, 2) not finite; pixel (1, 1) flat inside
-	 * (its sub-pixels equal), so the cap and the spread are both seen */
+	 * (its sub-pixels equal): no spread of its own to add */
 	g.px[((size_t)(2 * 2) * g.w + 2 * 4 + 1) * 3 + 1] = NAN;
 	for (int j = 0; j < 2; j++)
 		for (int l = 0; l < 2; l++)
 			for (int k = 0; k < 3; k++)
 				g.px[((size_t)(2 + j) * g.w + 2 + l) * 3 + k] = 0.4f;
+	make_render(&g8, 2 * W, 0, 2 * H, 9);
 	size_t npx = (size_t)W * H, bytes = npx * ACC_NCH * sizeof(float);
 	float *before = malloc(bytes);
 	assert_non_null(before);
-	memcpy(before, acc.px, bytes);
-	assert_int_equal(accum_merge_region(&acc, &g, 0, 8, 1, 1, 4, 2, 2, &folded, err,
-					    sizeof(err)), 0);
-	assert_int_equal(folded, 8);
-	const double gs = 17.0;	/* samples per sub-pixel at scale 8: 4 x 4 + 1 */
-	for (int y = 0; y < H; y++)
-		for (int x = 0; x < W; x++) {
-			size_t i = (size_t)y * W + x;
-			const float *o = accpx(&acc, i), *b = before + i * ACC_NCH;
-			char what[64];
-			if (x < 1 || x > 4 || y < 1 || y > 2) {
-				assert_memory_equal(o, b, ACC_NCH * sizeof(float));
-				continue;
-			}
-			double sub[4][3];
-			int nq = 0;
-			for (int j = 0; j < 2; j++)
-				for (int l = 0; l < 2; l++) {
-					if (x == 4 && y == 2 && j == 0 && l == 1)
-						continue;
-					for (int c = 0; c < 3; c++)
-						sub[nq][c] = render_at(&g, 0, 2 * x + l, 2 * y + j, c);
-					nq++;
+	for (int step = 0; step < 2; step++) {
+		const int s = step ? 8 : 16, f = 2;
+		const struct image *r = step ? &g8 : &g;
+		/* per sub-pixel (s/2)^2 + 1 samples, the centre one scale 2's
+		 * again: every pixel has scale 2, so it is taken out */
+		const double g0 = step ? 17.0 : 65.0, gs = g0 - 1.0;
+		memcpy(before, acc.px, bytes);
+		assert_int_equal(accum_merge_region(&acc, r, 0, s, 1, 1, 4, 2, 2 + step, &folded,
+						    err, sizeof(err)), 0);
+		assert_int_equal(folded, 8);
+		for (int y = 0; y < H; y++)
+			for (int x = 0; x < W; x++) {
+				size_t i = (size_t)y * W + x;
+				const float *o = accpx(&acc, i), *b = before + i * ACC_NCH;
+				char what[64];
+				if (x < 1 || x > 4 || y < 1 || y > 2) {
+					assert_memory_equal(o, b, ACC_NCH * sizeof(float));
+					continue;
 				}
-			double na = b[ACC_SAMPLES], nb = nq * gs, nt = na + nb;
-			assert_true(o[ACC_SAMPLES] == (float)nt);
-			assert_true(o[ACC_SCALES] == (float)(2 + 4 + 256));
-			assert_true(o[ACC_PASS] == 2.0f);
-			for (int c = 0; c < 3; c++) {
-				double m = 0.0, bsum = 0.0;
-				for (int q = 0; q < nq; q++)
-					m += sub[q][c] / nq;
-				for (int q = 0; q < nq; q++)
-					bsum += (sub[q][c] - m) * (sub[q][c] - m);
-				double v = gs * bsum / (nq - 1);
-				if (b[ACC_VAR_R + c] < v)
-					v = b[ACC_VAR_R + c];
-				double m2b = gs * bsum + nq * (gs - 1.0) * v;
-				double d = m - b[c];
-				double mt = b[c] + d * nb / nt;
-				double vt = ((double)b[ACC_VAR_R + c] * (na - 1.0) + m2b +
-					     d * d * na * nb / nt) / (nt - 1.0);
-				snprintf(what, sizeof(what), "(%d,%d) c%d mean", x, y, c);
-				assert_close(o[c], mt, 1e-6, 0.0, what);
-				snprintf(what, sizeof(what), "(%d,%d) c%d variance", x, y, c);
-				assert_close(o[ACC_VAR_R + c], vt, 1e-5, 1e-12, what);
-				if (x == 1 && y == 1)	/* no spread inside: only the fold's */
-					assert_close(o[ACC_VAR_R + c],
-						     ((double)b[ACC_VAR_R + c] * (na - 1.0) +
-						      d * d * na * nb / nt) / (nt - 1.0),
-						     1e-5, 1e-12, what);
+				double sub[4][3], m[3] = { 0.0, 0.0, 0.0 }, m2[3], n, em[3], ev[3];
+				int nq = 0;
+				for (int j = 0; j < f; j++)
+					for (int l = 0; l < f; l++) {
+						if (!step && x == 4 && y == 2 && j == 0 && l == 1)
+							continue;
+						for (int c = 0; c < 3; c++) {
+							sub[nq][c] = (g0 * render_at(r, 0, f * x + l,
+										     f * y + j, c) -
+								      b[c]) / gs;
+							m[c] += sub[nq][c];
+						}
+						nq++;
+					}
+				for (int c = 0; c < 3; c++) {
+					double bs = 0.0;
+					m[c] /= nq;
+					for (int q = 0; q < nq; q++)
+						bs += (sub[q][c] - m[c]) * (sub[q][c] - m[c]);
+					double v = b[ACC_VAR_R + c];
+					if (nq > 1 && gs * bs / (nq - 1) < v)
+						v = gs * bs / (nq - 1);
+					m2[c] = gs * bs + nq * (gs - 1.0) * v;
+				}
+				expect_fold(b, nq * gs, m, m2, &n, em, ev);
+				snprintf(what, sizeof(what), "s%d (%d,%d) samples", s, x, y);
+				assert_close(o[ACC_SAMPLES], n, 1e-5, 0.0, what);
+				assert_true(o[ACC_SCALES] ==
+					    (float)(2 + 4 + 65536 + (step ? 256 : 0)));
+				assert_true(o[ACC_PASS] == (float)(2 + step));
+				for (int c = 0; c < 3; c++) {
+					snprintf(what, sizeof(what), "s%d (%d,%d) c%d mean", s, x, y,
+						 c);
+					assert_close(o[c], em[c], 1e-5, 0.0, what);
+					snprintf(what, sizeof(what), "s%d (%d,%d) c%d variance", s,
+						 x, y, c);
+					assert_close(o[ACC_VAR_R + c], ev[c], 1e-4, 1e-12, what);
+				}
 			}
-		}
+	}
 	/* the same scale again: nothing */
 	memcpy(before, acc.px, bytes);
-	assert_int_equal(accum_merge_region(&acc, &g, 0, 8, 1, 1, 4, 2, 3, &folded, err,
+	assert_int_equal(accum_merge_region(&acc, &g8, 0, 8, 1, 1, 4, 2, 4, &folded, err,
 					    sizeof(err)), 0);
 	assert_int_equal(folded, 0);
 	assert_memory_equal(before, acc.px, bytes);
 	/* three times the width at scale 8: neither 8 x W nor a grid render */
 	make_render(&bad, 3 * W, 0, 3 * H, 8);
 	err[0] = '\0';
-	assert_int_equal(accum_merge_region(&acc, &bad, 0, 8, 0, 0, 1, 1, 3, &folded, err,
+	assert_int_equal(accum_merge_region(&acc, &bad, 0, 8, 0, 0, 1, 1, 4, &folded, err,
 					    sizeof(err)), -1);
 	assert_non_null(strstr(err, "48"));
 	assert_non_null(strstr(err, "12 (a grid render)"));
 	assert_memory_equal(before, acc.px, bytes);
 	image_release(&bad);
 	free(before);
+	image_release(&g8);
 	image_release(&g);
 	image_release(&r2);
 	image_release(&acc);
@@ -1011,6 +1039,22 @@ static void test_plan_job(void **state)
 		assert_string_equal(job.extra[5], "+J0.5");
 		assert_int_equal(accum_grid_samples(s), s * s + 4);
 	}
+	/* which scales are grid renders */
+	struct plan_params pp;
+	plan_params_init(&pp);
+	assert_int_equal(pp.grid, PLAN_GRID_NEVER);
+	assert_false(plan_grid_scale(&pp, 640, 480, 16));
+	pp.grid = PLAN_GRID_ALWAYS;
+	assert_true(plan_grid_scale(&pp, 8, 6, 4));
+	assert_false(plan_grid_scale(&pp, 640, 480, 2));
+	pp.grid = PLAN_GRID_LARGE;	/* the scaled frame above 1 Mpixel */
+	assert_false(plan_grid_scale(&pp, 80, 60, 8));	/* 640x480 */
+	assert_true(plan_grid_scale(&pp, 80, 60, 16));	/* 1280x960 */
+	assert_false(plan_grid_scale(&pp, 160, 120, 4));
+	assert_true(plan_grid_scale(&pp, 160, 120, 8));
+	assert_false(plan_grid_scale(&pp, 512, 512, 2));
+	assert_false(plan_grid_scale(&pp, 256, 256, 4));	/* exactly 1 Mpixel */
+	assert_true(plan_grid_scale(&pp, 640, 480, 4));
 	/* scale 2 stays a plain render at twice the size */
 	r.scale = 2;
 	plan_job(&base, &r, "out/t.exr", &region, aextra, &job);
