@@ -70,9 +70,9 @@ static inline int accum_render_factor(int s)
  * accum_grid_samples(s) = s^2 + 4 samples: an s x s jittered grid, and the
  * 4 positions of scale 2 again.  Where the pixel has had scale 2 those 4
  * repeat samples it has (exactly, in a scene without randomness: counted
- * twice they made the mean worse than its count and the fold difference
- * smaller than the error; on glossy_reflection's micro-bumps the estimate
- * fell to 0.6 of the true relMSE), so they are taken out, the pixel's mean
+ * twice they make the mean worse than its count says and the fold
+ * difference smaller than the mean's error, an estimate too low under
+ * glossy_reflection's micro-bumps), so they are taken out, the pixel's mean
  * standing in for them, and the pixel gets s^2 new samples.  (Full jitter, +J, moves samples up to a
  * whole cell, out of the pixel: a wider filter than the pixel's box, which
  * at hdr_highlights' lamps made the error 4 times scale 8's.  At the
