@@ -965,6 +965,18 @@ static void test_regions_file(void **state)
 }
 
 /* 8. The POV-Ray job for a region. */
+/* The antialiasing options a region job appends after the user's two:
+ * method, threshold 0, depth, jitter. */
+static void assert_aa_options(const struct pov_job *job, const char *method, const char *depth,
+			      const char *jitter)
+{
+	assert_int_equal(job->nextra, 6);
+	assert_string_equal(job->extra[2], method);
+	assert_string_equal(job->extra[3], "+A0.0");
+	assert_string_equal(job->extra[4], depth);
+	assert_string_equal(job->extra[5], jitter);
+}
+
 static void test_plan_job(void **state)
 {
 	static const char *const base_extra[] = { "+Q9", "Antialias_Threshold=0.1" };
@@ -1008,12 +1020,8 @@ static void test_plan_job(void **state)
 	assert_int_equal(job.height, 48);
 	assert_int_equal(region.x0, 3);
 	assert_int_equal(region.y1, 7);
-	assert_int_equal(job.nextra, 6);
 	assert_string_equal(job.extra[1], "Antialias_Threshold=0.1");
-	assert_string_equal(job.extra[2], "+AM2");
-	assert_string_equal(job.extra[3], "+A0.0");
-	assert_string_equal(job.extra[4], "+R4");
-	assert_string_equal(job.extra[5], "+J");
+	assert_aa_options(&job, "+AM2", "+R4", "+J");
 	char name[64];
 	plan_output_name(name, sizeof(name), "w", 3, 7, ACC_AA);
 	assert_string_equal(name, "w/p03-r007-aa.exr");
@@ -1032,11 +1040,7 @@ static void test_plan_job(void **state)
 		assert_int_equal(region.y0, 4);
 		assert_int_equal(region.x1, 21);
 		assert_int_equal(region.y1, 15);
-		assert_int_equal(job.nextra, 6);
-		assert_string_equal(job.extra[2], "+AM1");
-		assert_string_equal(job.extra[3], "+A0.0");
-		assert_string_equal(job.extra[4], s == 4 ? "+R2" : s == 8 ? "+R4" : "+R8");
-		assert_string_equal(job.extra[5], "+J0.5");
+		assert_aa_options(&job, "+AM1", s == 4 ? "+R2" : s == 8 ? "+R4" : "+R8", "+J0.5");
 		assert_int_equal(accum_grid_samples(s), s * s + 4);
 	}
 	/* which scales are grid renders */
