@@ -79,7 +79,7 @@ static inline int accum_render_factor(int s)
  * image's size, +R(s), the means under focal blur erred twice as much.)
  * POV-Ray holds and writes its whole frame, whose cost grows with the
  * frame's size whatever the region's (at 640x480, scale 8 writes a
- * 5120x3840 frame for about 1.5 CPU seconds), so a grid render costs what
+ * 5120x3840 frame for about 3 CPU seconds), so a grid render costs what
  * its samples cost.  Its pixels come as 4 means, not as samples; see
  * accum_merge_region().
  */
