@@ -395,13 +395,12 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 	int oy = 0;
 	if (folded)
 		*folded = 0;
-	int f = accum_render_factor(s);
+	int f = accum_render_factor(s), w, h;
 	if (s >= 4) {	/* a grid render or not: the render's width says */
-		if (image_read_exr_rows(path, 0, 0, &img, &oy, err, errlen))
+		if (image_exr_size(path, &w, &h, err, errlen))
 			return -1;
-		if (img.w == acc->w * ACC_GRID_FRAME)
+		if (w == acc->w * ACC_GRID_FRAME)
 			f = ACC_GRID_FRAME;
-		image_release(&img);
 	}
 	int rc = image_read_exr_rows(path, y0 * f, (y1 + 1) * f - 1, &img, &oy, err, errlen) ||
 		 accum_merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, folded, err, errlen);

@@ -243,6 +243,7 @@ struct reader {
 	char *err;
 	size_t errlen;
 	int band;		/* read only rows band_y0..band_y1 (scanline files) */
+	int header;		/* read only the size: img->w, img->h, no pixels */
 	int band_y0, band_y1;	/* in: wanted rows; out: rows read, image-relative */
 };
 
@@ -439,6 +440,11 @@ static int read_part0(struct reader *rd)
 			"per line is too many", rd->path, (long long)w, chl->num_channels);
 		return -1;
 	}
+	if (rd->header) {
+		rd->img->w = (int)w;
+		rd->img->h = (int)h;
+		return 0;
+	}
 	names = calloc((size_t)chl->num_channels, sizeof(*names));
 	if (!names) {
 		errbuf_printf(rd->err, rd->errlen, "cannot read '%s': out of memory", rd->path);
@@ -509,21 +515,34 @@ out:
 	return ret;
 }
 
-static int read_exr(const char *path, int band, int y0, int y1, struct image *out,
+/* What read_exr() reads: the whole image, rows of it, or its size. */
+enum { READ_ALL, READ_ROWS, READ_SIZE };
+
+static int read_exr(const char *path, int what, int y0, int y1, struct image *out,
 		    int *oy, char *err, size_t errlen);
 
 int image_read_exr(const char *path, struct image *out, char *err, size_t errlen)
 {
-	return read_exr(path, 0, 0, 0, out, NULL, err, errlen);
+	return read_exr(path, READ_ALL, 0, 0, out, NULL, err, errlen);
 }
 
 int image_read_exr_rows(const char *path, int y0, int y1, struct image *out, int *oy,
 			char *err, size_t errlen)
 {
-	return read_exr(path, 1, y0, y1, out, oy, err, errlen);
+	return read_exr(path, READ_ROWS, y0, y1, out, oy, err, errlen);
 }
 
-static int read_exr(const char *path, int band, int y0, int y1, struct image *out,
+int image_exr_size(const char *path, int *w, int *h, char *err, size_t errlen)
+{
+	struct image img;
+	if (read_exr(path, READ_SIZE, 0, 0, &img, NULL, err, errlen))
+		return -1;
+	*w = img.w;
+	*h = img.h;
+	return 0;
+}
+
+static int read_exr(const char *path, int what, int y0, int y1, struct image *out,
 		    int *oy, char *err, size_t errlen)
 {
 	exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
@@ -541,7 +560,8 @@ static int read_exr(const char *path, int band, int y0, int y1, struct image *ou
 	rd.path = path;
 	rd.err = err;
 	rd.errlen = errlen;
-	rd.band = band;
+	rd.band = what == READ_ROWS;
+	rd.header = what == READ_SIZE;
 	rd.band_y0 = y0;
 	rd.band_y1 = y1;
 

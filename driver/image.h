@@ -52,6 +52,10 @@ int image_read_exr(const char *path, struct image *out, char *err, size_t errlen
 int image_read_exr_rows(const char *path, int y0, int y1, struct image *out, int *oy,
 			char *err, size_t errlen);
 
+/* The size of an EXR's data window, from its header alone.  Errors as
+ * image_read_exr(). */
+int image_exr_size(const char *path, int *w, int *h, char *err, size_t errlen);
+
 /*
  * Write img as a single-part scanline EXR, 32-bit float, PIZ compression,
  * one channel per img channel with img's names (OpenEXR stores channels

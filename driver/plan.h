@@ -108,12 +108,11 @@ void plan_release(struct plan *pl);
 
 /*
  * The POV-Ray job for region r of a plan, rendering into output: the
- * region at r->scale times base, with antialiasing off, at twice base with
- * twice base with +AM1 +A0.0 +R(scale/2) +J0.5 for a grid render (r->frame
- * ACC_GRID_FRAME),
- * or at scale 1 with POV-Ray's antialiasing when r->scale is ACC_AA (the
- * options appended
- * after the user's, which come from base->extra).  base gives the scene,
+ * region at r->scale times base with antialiasing off; for a grid render
+ * (r->frame ACC_GRID_FRAME) at twice base with +AM1 +A0.0 +R(scale/2)
+ * +J0.5; when r->scale is ACC_AA at scale 1 with POV-Ray's antialiasing
+ * (the options appended after the user's, which come from base->extra).
+ * base gives the scene,
  * full size, threads, defines, extra options, work directory and binary;
  * the job borrows region (storage for the scaled rectangle) and extra
  * (storage for base->nextra + 4 pointers).

@@ -165,6 +165,12 @@ struct run {
 enum { SAMPLER_SCALE, SAMPLER_AA, SAMPLER_GRID, SAMPLER_AUTO, NSAMPLERS };
 static const char *const sampler_names[NSAMPLERS] = { "scale", "aa", "grid", "auto" };
 
+static void print_usage(FILE *f)
+{
+	fputs(usage, f);
+	fputs(usage_options, f);
+}
+
 static void progress(struct run *r, const char *fmt, ...)
 	__attribute__((format(printf, 2, 3)));
 
@@ -934,8 +940,7 @@ int cmd_render(int argc, char **argv)
 			i++;
 			break;
 		} else if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-			fputs(usage, stdout);
-			fputs(usage_options, stdout);
+			print_usage(stdout);
 			return 0;
 		} else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
 			r.quiet = 1;
@@ -946,8 +951,8 @@ int cmd_render(int argc, char **argv)
 		} else if (!strcmp(a, "--resume")) {
 			r.resume = 1;
 		} else if (!more && a[0] == '-') {
-			fprintf(stderr, "povpress render: unknown option or missing value '%s'\n%s%s",
-				a, usage, usage_options);
+			fprintf(stderr, "povpress render: unknown option or missing value '%s'\n", a);
+			print_usage(stderr);
 			return 2;
 		} else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
 			r.out = argv[++i];
@@ -1008,14 +1013,15 @@ int cmd_render(int argc, char **argv)
 			else
 				goto bad;
 		} else if (a[0] == '-' && a[1]) {
-			fprintf(stderr, "povpress render: unknown option '%s'\n%s%s", a, usage,
-				usage_options);
+			fprintf(stderr, "povpress render: unknown option '%s'\n", a);
+			print_usage(stderr);
 			return 2;
 		} else if (!r.scene) {
 			r.scene = a;
 		} else {
 			fprintf(stderr, "povpress render: unexpected argument '%s' (POV-Ray options go "
-				"after --)\n%s%s", a, usage, usage_options);
+				"after --)\n", a);
+			print_usage(stderr);
 			return 2;
 		}
 		continue;
@@ -1026,9 +1032,9 @@ bad:
 	r.extra = (const char *const *)argv + i;
 	r.nextra = (size_t)(argc - i);
 	if (!r.scene || !r.out) {
-		fprintf(stderr, "povpress render: %s\n%s%s",
-			!r.scene ? "no scene given" : "no output given (-o OUT.exr)", usage,
-			usage_options);
+		fprintf(stderr, "povpress render: %s\n",
+			!r.scene ? "no scene given" : "no output given (-o OUT.exr)");
+		print_usage(stderr);
 		return 2;
 	}
 	if (!r.error_map) {

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # How should a region get more samples: POV-Ray's own adaptive antialiasing
-# (+AM2), resolution scaling, or grid renders (+AM1 with a threshold of 0)?  For each scene this takes the region the
-# render loop's first pass re-renders (from `povpress render --max-passes 1`)
+# (+AM2), resolution scaling, or grid renders (+AM1 with a threshold of 0)?
+# For each scene this takes the region the render loop's first pass
+# re-renders (from `povpress render --max-passes 1`)
 # and renders that same region each way, one thread, as region renders
 # (so each run pays what a real region render pays), then measures the CPU
 # seconds of the povray process and the relMSE over the region's pixels
@@ -64,11 +65,10 @@ for name in "${scenes[@]}"; do
 	# grid renders (render --sampler grid): scale k at twice the size with
 	# +AM1 +A0.0 +R(k/2) +J0.5, k^2 + 4 samples per pixel
 	for k in 4 8 16; do
-		f=2
-		c=$(cpu_of povray "${common[@]}" +AM1 +A0.0 +R$((k / f)) +J0.5 +W$((f * W)) \
-			+H$((f * H)) +SC$((x0 * f + 1)) +EC$(((x1 + 1) * f)) +SR$((y0 * f + 1)) \
-			+ER$(((y1 + 1) * f)) "+O\"$T/g.exr\"")
-		"$BOXDOWN" "$T/g.exr" "$f" "$T/gd.exr" >/dev/null
+		c=$(cpu_of povray "${common[@]}" +AM1 +A0.0 +R$((k / 2)) +J0.5 +W$((2 * W)) \
+			+H$((2 * H)) +SC$((x0 * 2 + 1)) +EC$(((x1 + 1) * 2)) +SR$((y0 * 2 + 1)) \
+			+ER$(((y1 + 1) * 2)) "+O\"$T/g.exr\"")
+		"$BOXDOWN" "$T/g.exr" 2 "$T/gd.exr" >/dev/null
 		e=$(region_relmse "$T/gd.exr" "$ref" "$x0" "$y0" "$x1" "$y1")
 		echo "$name,grid,$k,$c,$e" >>"$OUT/sampler.csv"
 	done

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# samplers.sh - `povpress render --sampler scale|aa` side by side.
+# samplers.sh - `povpress render --sampler auto|grid|scale|aa` side by side.
 #
 # usage: scripts/samplers.sh [BUILD_DIR] [SCENE ...]
 #
@@ -8,7 +8,8 @@
 # at --target 1e-3 and 3e-4, and prints per run the CPU seconds of povpress
 # and its POV-Ray children, the relMSE against make sweep's 625-sample
 # reference (run `make sweep` first: the references are its cache) and the
-# estimated relMSE.  MODES="scale aa" (the default) chooses the samplers.
+# estimated relMSE.  MODES chooses the samplers (default "scale aa"; the
+# README's table is MODES="auto grid scale aa").
 set -eu
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)

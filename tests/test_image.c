@@ -383,6 +383,11 @@ static void test_data_window_offset(void **state)
 
 	assert_int_equal(image_read_exr(path, &got, err, sizeof(err)), 0);
 	assert_same_pixels(&got, &img);
+	/* the size alone, from the header: the data window's */
+	int w = 0, h = 0;
+	assert_int_equal(image_exr_size(path, &w, &h, err, sizeof(err)), 0);
+	assert_int_equal(w, 40);
+	assert_int_equal(h, 21);
 	image_release(&got);
 	image_release(&img);
 }
@@ -555,6 +560,10 @@ static void test_missing_file(void **state)
 	assert_non_null(strstr(err, "cannot open"));
 	assert_non_null(strstr(err, strerror(ENOENT)));
 	assert_zeroed(&got);
+	int w, h;
+	err[0] = '\0';
+	assert_int_equal(image_exr_size(path, &w, &h, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "cannot open"));
 }
 
 static void test_not_exr(void **state)

@@ -965,6 +965,19 @@ static void test_regions_file(void **state)
 }
 
 /* 8. The POV-Ray job for a region. */
+/* A region job's frame (w x h) and the rectangle in it it renders. */
+static void assert_job_frame(const struct pov_job *job, const struct pov_region *region, int w,
+			     int h, int x0, int y0, int x1, int y1)
+{
+	assert_int_equal(job->width, w);
+	assert_int_equal(job->height, h);
+	assert_ptr_equal(job->region, region);
+	assert_int_equal(region->x0, x0);
+	assert_int_equal(region->y0, y0);
+	assert_int_equal(region->x1, x1);
+	assert_int_equal(region->y1, y1);
+}
+
 /* The antialiasing options a region job appends after the user's two:
  * method, threshold 0, depth, jitter. */
 static void assert_aa_options(const struct pov_job *job, const char *method, const char *depth,
@@ -995,13 +1008,7 @@ static void test_plan_job(void **state)
 	base.extra = base_extra;
 	base.nextra = 2;
 	plan_job(&base, &r, "out/r.exr", &region, extra, &job);
-	assert_int_equal(job.width, 256);
-	assert_int_equal(job.height, 192);
-	assert_ptr_equal(job.region, &region);
-	assert_int_equal(region.x0, 12);
-	assert_int_equal(region.y0, 8);
-	assert_int_equal(region.x1, 43);
-	assert_int_equal(region.y1, 31);
+	assert_job_frame(&job, &region, 256, 192, 12, 8, 43, 31);
 	assert_string_equal(job.output, "out/r.exr");
 	assert_string_equal(job.scene, "scenes/x.pov");
 	assert_int_equal(job.threads, 3);
@@ -1034,12 +1041,7 @@ static void test_plan_job(void **state)
 		r.scale = s;
 		r.frame = ACC_GRID_FRAME;
 		plan_job(&base, &r, "out/g.exr", &region, aextra, &job);
-		assert_int_equal(job.width, 128);
-		assert_int_equal(job.height, 96);
-		assert_int_equal(region.x0, 6);
-		assert_int_equal(region.y0, 4);
-		assert_int_equal(region.x1, 21);
-		assert_int_equal(region.y1, 15);
+		assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
 		assert_aa_options(&job, "+AM1", s == 4 ? "+R2" : s == 8 ? "+R4" : "+R8", "+J0.5");
 		assert_int_equal(accum_grid_samples(s), s * s + 4);
 	}
