@@ -900,6 +900,92 @@ static void test_plan_make(void **state)
 	free(in);
 }
 
+/* The factor value_bias() puts on a pixel's relative error (accum.c): mean
+ * over R, G, B of m^2 + 0.01 over that of max(m^2 - var / n, m^2 / 4) + 0.01. */
+static double want_bias(const float *o)
+{
+	double a = 0.0, b = 0.0;
+	for (int c = 0; c < 3; c++) {
+		double m2 = (double)o[c] * o[c], x2 = m2 - o[ACC_VAR_R + c] / o[ACC_SAMPLES];
+		a += m2 + 0.01;
+		b += (x2 > 0.25 * m2 ? x2 : 0.25 * m2) + 0.01;
+	}
+	return a / b;
+}
+
+/* Pixel (x, y) of a 7 x 7 accumulation given n samples of variance var
+ * and the fold difference diff. */
+static void set_px(struct image *acc, int x, int y, float n, float var, float diff)
+{
+	float *o = accpx(acc, (size_t)y * acc->w + x);
+	o[ACC_SAMPLES] = n;
+	for (int c = 0; c < 3; c++)
+		o[ACC_VAR_R + c] = var;
+	o[ACC_DIFF] = diff;
+}
+
+/* 6b. A pixel's error estimate: fold differences averaged over neighbours
+ * of like sample variance, relative to an estimate of the true value. */
+static void test_pixel_errors(void **state)
+{
+	enum { N = 7 };
+	struct image acc;
+	float press[N * N], fit[3 * N * N];
+	double e[N * N];
+
+	(void)state;
+	make_acc(&acc, N, N, flat_value);
+	for (int i = 0; i < N * N; i++) {
+		press[i] = 1e-6f;
+		fit[3 * i] = fit[3 * i + 1] = fit[3 * i + 2] = 0.5f;
+	}
+	/* flat rows of small variance and difference; row 3 an edge across
+	 * the image: large variance, large difference */
+	for (int y = 0; y < N; y++)
+		for (int x = 0; x < N; x++)
+			set_px(&acc, x, y, 5.0f, y == 3 ? 0.05f : 1e-6f, y == 3 ? 0.1f : 1e-6f);
+	/* one flat pixel whose difference came out larger */
+	set_px(&acc, 6, 6, 5.0f, 1e-6f, 2.5e-5f);
+	plan_pixel_errors(&acc, press, fit, e);
+
+	const double flat_bias = want_bias(accpx(&acc, 0)), edge_bias = want_bias(accpx(&acc, 21));
+	/* two rows from the edge: the edge's five differences (a plain mean
+	 * would make 0.02 of them) are a variance ratio of 5e4 away */
+	assert_close(e[1 * N + 3], 1e-6 * flat_bias, 1e-3, 0.0, "flat pixel beside the edge");
+	/* the edge pixel keeps its own row's difference */
+	assert_close(e[3 * N + 3], 0.1 * edge_bias, 1e-3, 0.0, "edge pixel");
+	/* alike variances: the plain mean of the 3 x 3 window in the corner */
+	assert_close(e[6 * N + 6], (8 * 1e-6 + 2.5e-5) / 9.0 * flat_bias, 1e-3, 0.0,
+		     "corner pixel");
+	/* (5, 5)'s window, rows 3 to 6 and columns 3 to 6: the 12 flat pixels
+	 * count, the 4 of the edge row do not */
+	assert_close(e[5 * N + 5], (11 * 1e-6 + 2.5e-5) / 12.0 * flat_bias, 1e-3, 0.0,
+		     "window across the edge row");
+	assert_true(flat_bias > 1.0 && flat_bias < 1.0001);
+	image_release(&acc);
+
+	/* a firefly: 5 samples of which one bright lifts the mean to 0.83;
+	 * the error relative to it hid how far off the pixel is */
+	make_acc(&acc, 1, 1, flat_value);
+	float *o = accpx(&acc, 0);
+	for (int c = 0; c < 3; c++)
+		o[c] = 0.83f;
+	set_px(&acc, 0, 0, 5.0f, 2.18f, 0.05f);
+	double got = accum_pixel_error(&acc, 0, 1e-6, fit, 0.05);
+	assert_close(got, 0.05 * want_bias(o), 1e-6, 0.0, "firefly");
+	assert_true(got > 2.5 * 0.05 && got < 2.8 * 0.05);
+	/* its true value estimated below a quarter of m^2: the floor */
+	set_px(&acc, 0, 0, 5.0f, 5.0f, 0.05f);
+	got = accum_pixel_error(&acc, 0, 1e-6, fit, 0.05);
+	assert_close(got, 0.05 * (3 * (0.83 * 0.83 + 0.01)) / (3 * (0.25 * 0.83 * 0.83 + 0.01)),
+		     1e-5, 0.0, "firefly at the floor");
+	/* the variance of the mean, where there is no fold difference */
+	got = accum_pixel_error(&acc, 0, 1e-6, fit, NAN);
+	assert_close(got, 5.0 / 5.0 / (0.83 * 0.83 + 0.01) * want_bias(o), 1e-5, 0.0,
+		     "variance of the mean");
+	image_release(&acc);
+}
+
 /* 7. The regions file round-trips; a bad line is reported with its number. */
 static void test_regions_file(void **state)
 {
@@ -1080,6 +1166,7 @@ int main(void)
 		cmocka_unit_test(test_accum_read),
 		cmocka_unit_test(test_read_rows),
 		cmocka_unit_test(test_plan_make),
+		cmocka_unit_test(test_pixel_errors),
 		cmocka_unit_test(test_regions_file),
 		cmocka_unit_test(test_plan_job),
 	};
