@@ -290,8 +290,18 @@ out:
 
 int plan_grid_scale(const struct plan_params *p, int w, int h, int s)
 {
-	return s >= 4 && (p->grid == PLAN_GRID_ALWAYS ||
+	return s >= 4 && (p->grid == PLAN_GRID_ALWAYS || p->grid == PLAN_GRID_ONLY ||
 			  (p->grid == PLAN_GRID_LARGE && (double)s * s * w * h > PLAN_GRID_FRAME));
+}
+
+int plan_next_scale(const struct plan_params *p, const struct image *acc, size_t i)
+{
+	for (int k = 0; k < ACC_NSCALES; k++) {
+		int s = accum_scales[k];
+		if (!accum_has_scale(acc, i, s) && !(s == 2 && p->grid == PLAN_GRID_ONLY))
+			return s;
+	}
+	return 0;
 }
 
 static int by_value(const void *a, const void *b)
@@ -377,7 +387,7 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 		smax /= 2;
 	size_t nc = 0;
 	for (size_t i = 0; i < npx; i++) {
-		int s = accum_next_scale(acc, i);
+		int s = plan_next_scale(p, acc, i);
 		if (!s || s > smax)
 			continue;
 		double n = acc->px[i * ACC_NCH + ACC_SAMPLES], m = (double)s * s;
@@ -398,7 +408,7 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	size_t taken = 0;
 	for (; taken < nc && total > goal; taken++) {
 		size_t i = cand[taken].i;
-		int s = accum_next_scale(acc, i);
+		int s = plan_next_scale(p, acc, i);
 		double c = p->cost_sample * s * s;
 		if (p->budget > 0.0 && spend + c > p->budget)
 			break;
@@ -418,7 +428,7 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 		memset(mark, 0, npx);
 		for (size_t t = 0; t < taken; t++) {
 			size_t i = cand[t].i;
-			if (accum_next_scale(acc, i) == s) {
+			if (plan_next_scale(p, acc, i) == s) {
 				mark[i] = 1;
 				any = 1;
 			}

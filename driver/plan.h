@@ -43,12 +43,18 @@ struct plan_params {
 };
 
 /* Grid renders: never (resolution scaling), for every scale of 4 or more,
- * or for those whose scaled frame would exceed PLAN_GRID_FRAME pixels. */
-enum { PLAN_GRID_NEVER, PLAN_GRID_ALWAYS, PLAN_GRID_LARGE };
+ * or for those whose scaled frame would exceed PLAN_GRID_FRAME pixels; or
+ * (PLAN_GRID_ONLY) for every scale of 4 or more with no scale 2 before
+ * them, so that every sample added to the base pass is jittered. */
+enum { PLAN_GRID_NEVER, PLAN_GRID_ALWAYS, PLAN_GRID_LARGE, PLAN_GRID_ONLY };
 #define PLAN_GRID_FRAME (1024.0 * 1024.0)
 
 /* Whether scale s of a w x h image is rendered as a grid render. */
 int plan_grid_scale(const struct plan_params *p, int w, int h, int s);
+
+/* The scale pixel i of acc is refined at next: accum_next_scale(), but
+ * past scale 2 under PLAN_GRID_ONLY. */
+int plan_next_scale(const struct plan_params *p, const struct image *acc, size_t i);
 
 void plan_params_init(struct plan_params *p);
 

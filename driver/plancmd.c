@@ -25,7 +25,8 @@ static const char plan_usage[] =
 	"usage: povpress plan ANALYSIS.exr --scene SCENE.pov -o DIR [--state ACCUM.exr]\n"
 	"                     [--pass N] [--target RELMSE] [--budget SECONDS]\n"
 	"                     [--cost-job SECONDS] [--cost-sample SECONDS]\n"
-	"                     [--max-regions N] [--sampler auto|grid|scale] [--threads N]\n"
+	"                     [--max-regions N] [--sampler auto|grid|scale|jitter]\n"
+	"                     [--threads N]\n"
 	"                     [--radiosity FILE]\n"
 	"                     [-- POVRAY_OPTIONS...]\n"
 	"\n"
@@ -56,8 +57,8 @@ static const char plan_usage[] =
 	"  --sampler S         how scales 4, 8 and 16 are rendered, as in 'render': auto\n"
 	"                      (default: grid where scaling's frame would exceed 1\n"
 	"                      Mpixel), grid (twice the size with +AM1 +A0.0\n"
-	"                      +R(scale/2) +J0.5) or scale (scale times the size, no\n"
-	"                      antialiasing)\n"
+	"                      +R(scale/2) +J0.5), scale (scale times the size, no\n"
+	"                      antialiasing) or jitter (grid, and no scale 2)\n"
 	"  --threads N         POV-Ray threads per job, +WT (default 1)\n"
 	"  --radiosity FILE    radiosity data the base pass saved (+RFO): jobs load it\n"
 	"  -- OPTIONS          passed to every POV-Ray job (as given to the base pass)\n"
@@ -162,9 +163,11 @@ int cmd_plan(int argc, char **argv)
 				pp.grid = PLAN_GRID_ALWAYS;
 			} else if (!strcmp(m, "scale")) {
 				pp.grid = PLAN_GRID_NEVER;
+			} else if (!strcmp(m, "jitter")) {
+				pp.grid = PLAN_GRID_ONLY;
 			} else {
 				fprintf(stderr,
-					"povpress plan: --sampler takes auto, grid or scale, not '%s'\n",
+					"povpress plan: --sampler takes auto, grid, scale or jitter, not '%s'\n",
 					m);
 				return 2;
 			}

@@ -41,7 +41,7 @@ static const char usage[] =
 	"                       [--workdir DIR] [--keep-workdir] [--resume]\n"
 	"                       [--error-map FILE] [--report FILE.json]\n"
 	"                       [--final auto|samples|reconstruction] [--radiosity-scale K]\n"
-	"                       [--sampler auto|grid|scale|aa]\n"
+	"                       [--sampler auto|grid|scale|aa|jitter]\n"
 	"                       [-q|-v]\n"
 	"                       [-- POVRAY_OPTIONS...]\n"
 	"\n"
@@ -90,7 +90,9 @@ static const char usage_options[] =
 	"                        whatever the region), or aa (scaling, and for pixels\n"
 	"                        with 21+ samples first, once per pixel, POV-Ray's\n"
 	"                        antialiasing, +AM2 +A0 +R4 +J, weighted by what it\n"
-	"                        proves worth); see the README\n"
+	"                        proves worth), or jitter (no scale-2 pass: scales 4, 8\n"
+	"                        and 16 as grid renders, so every sample added to the\n"
+	"                        base pass is jittered); see the README\n"
 	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
 	"                        pixel's samples; default), auto (the sample mean or the\n"
 	"                        regression's fit, whichever is predicted closer), or\n"
@@ -162,8 +164,8 @@ struct run {
 	int pool_done, pool_total, pool_pass;
 };
 
-enum { SAMPLER_SCALE, SAMPLER_AA, SAMPLER_GRID, SAMPLER_AUTO, NSAMPLERS };
-static const char *const sampler_names[NSAMPLERS] = { "scale", "aa", "grid", "auto" };
+enum { SAMPLER_SCALE, SAMPLER_AA, SAMPLER_GRID, SAMPLER_AUTO, SAMPLER_JITTER, NSAMPLERS };
+static const char *const sampler_names[NSAMPLERS] = { "scale", "aa", "grid", "auto", "jitter" };
 
 static void print_usage(FILE *f)
 {
@@ -743,9 +745,10 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	pp.cost_job = r->cost_job;
 	pp.cost_sample = r->cost_sample;
 	pp.max_regions = r->jobs > 8 ? r->jobs : 8;
-	pp.grid = r->sampler == SAMPLER_GRID   ? PLAN_GRID_ALWAYS
-		  : r->sampler == SAMPLER_AUTO ? PLAN_GRID_LARGE
-					       : PLAN_GRID_NEVER;
+	pp.grid = r->sampler == SAMPLER_GRID	 ? PLAN_GRID_ALWAYS
+		  : r->sampler == SAMPLER_AUTO	 ? PLAN_GRID_LARGE
+		  : r->sampler == SAMPLER_JITTER ? PLAN_GRID_ONLY
+						 : PLAN_GRID_NEVER;
 	if (r->budget > 0.0) {
 		double left = r->budget - elapsed(r);
 		/* in core-seconds, keeping a share for the analysis and the

@@ -192,13 +192,14 @@ else
 fi
 
 # --- --sampler: grid renders, resolution scaling, POV-Ray's antialiasing ----
-msg=$("$PP" render "$SC/smooth_empty.pov" -o "$T/x.exr" --sampler jitter 2>&1)
+msg=$("$PP" render "$SC/smooth_empty.pov" -o "$T/x.exr" --sampler random 2>&1)
 rc=$?
-check "render with --sampler jitter (not auto, grid, scale or aa) is a usage error (2)" test $rc -eq 2
+check "render with --sampler random (not auto, grid, scale, aa or jitter) is a usage error (2)" \
+	test $rc -eq 2
 check "... whose message names the option" grep -q -- "--sampler" <<<"$msg"
 scene="$SC/soft_shadows.pov"
 if ref=$(reference "$scene"); then
-	for m in scale aa grid; do
+	for m in scale aa grid jitter; do
 		"$PP" render "$scene" -o "$T/smp-$m.exr" -W $W -H $H --target 3e-4 --sampler $m -q \
 			--keep-workdir --report "$T/smp-$m.json" -- +WT1 ||
 			bad "--sampler $m: render failed"
@@ -229,6 +230,15 @@ if ref=$(reference "$scene"); then
 	# cost little, and its regular grids' fold differences at the horizon
 	# keep the loop going to scale 16; hence auto, scaling for small frames)
 	check "--sampler grid: relMSE at most 4 times --sampler scale's" num 'a <= 4 * b' "$gr" "$sc"
+	ji=$(relmse "$T/smp-jitter.exr" "$ref")
+	echo "# ... and $ji with --sampler jitter"
+	check "--sampler jitter: the report says so" grep -q '"sampler": "jitter"' "$T/smp-jitter.json"
+	check "--sampler jitter: no scale-2 region" \
+		test -z "$(compgen -G "$T/smp-jitter.exr.work/p*-s2.exr")"
+	j4=$(compgen -G "$T/smp-jitter.exr.work/p01-*-s4.exr" | head -n 1)
+	check "--sampler jitter: the first pass renders scale 4, at twice the width" \
+		grep -q "$((2 * W)) x *$((2 * H))" <(iinfo "$j4" 2>&1)
+	check "--sampler jitter: relMSE at most 4 times --sampler scale's" num 'a <= 4 * b' "$ji" "$sc"
 else
 	bad "soft_shadows: reference render failed"
 fi

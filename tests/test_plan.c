@@ -1147,6 +1147,40 @@ static void test_plan_job(void **state)
 	assert_false(plan_grid_scale(&pp, 512, 512, 2));
 	assert_false(plan_grid_scale(&pp, 256, 256, 4));	/* exactly 1 Mpixel */
 	assert_true(plan_grid_scale(&pp, 640, 480, 4));
+	/* --sampler jitter: grid renders from scale 4, and no scale 2 */
+	pp.grid = PLAN_GRID_ONLY;
+	assert_true(plan_grid_scale(&pp, 8, 6, 4));
+	assert_false(plan_grid_scale(&pp, 8, 6, 2));
+	struct image acc;
+	make_acc(&acc, 4, 1, flat_value);	/* scale 1 (the base) everywhere */
+	accpx(&acc, 1)[ACC_SCALES] = 2 + 4;	/* 1 and 2 */
+	accpx(&acc, 2)[ACC_SCALES] = 2 + 4 + 16;	/* 1, 2 and 4 */
+	accpx(&acc, 3)[ACC_SCALES] = 2 + 16 + 256 + 65536;	/* all but 2 */
+	static const int only[4] = { 4, 4, 8, 0 }, always[4] = { 2, 4, 8, 2 };
+	for (int i = 0; i < 4; i++) {
+		assert_int_equal(plan_next_scale(&pp, &acc, (size_t)i), only[i]);
+		pp.grid = PLAN_GRID_ALWAYS;
+		assert_int_equal(plan_next_scale(&pp, &acc, (size_t)i), always[i]);
+		pp.grid = PLAN_GRID_ONLY;
+	}
+	image_release(&acc);
+	/* a whole plan of base-pass pixels: grid renders of scale 4 only */
+	make_acc(&acc, 32, 16, base_value);
+	double e[32 * 16];
+	for (int i = 0; i < 32 * 16; i++)
+		e[i] = 0.05;
+	pp.target = 1e-3;
+	struct plan pl;
+	char err[256];
+	assert_int_equal(plan_make_from(&acc, e, &pp, &pl, err, sizeof(err)), 0);
+	assert_int_equal(pl.outcome, PLAN_REFINE);
+	assert_true(pl.nregions >= 1);
+	for (size_t k = 0; k < pl.nregions; k++) {
+		assert_int_equal(pl.regions[k].scale, 4);
+		assert_int_equal(pl.regions[k].frame, ACC_GRID_FRAME);
+	}
+	plan_release(&pl);
+	image_release(&acc);
 	/* scale 2 stays a plain render at twice the size */
 	r.scale = 2;
 	plan_job(&base, &r, "out/t.exr", &region, aextra, &job);
