@@ -5,7 +5,7 @@
 # POV-Ray thread: the same samples every run), its samples per pixel, its
 # relMSE and estimate, and the relMSE uniform scaling s = 1..10 would reach
 # with that many samples (interpolated in log-log between the two nearest
-# scales).  References: the scale-24 ones tests/render.sh caches (run
+# scales).  References: the scale-25 ones tests/render.sh caches (run
 # `make check` first).
 #
 # usage: scripts/equal_samples.sh [BUILD_DIR] [SCENE_NAME...]
