@@ -316,6 +316,7 @@ exec povray "$@"
 EOF
 chmod +x "$T/fakepov"
 for mode in crash hang; do
+	what=$([ $mode = crash ] && echo crashes || echo hangs)
 	: >"$T/fake.log"
 	FAKE=$mode FAKE_LOG="$T/fake.log" POVPRESS_POVRAY="$T/fakepov" "$PP" render \
 		"$SC/soft_shadows.pov" -o "$T/$mode.exr" -W 48 -H 36 --max-passes 1 --timeout 2 \
@@ -323,13 +324,13 @@ for mode in crash hang; do
 	rc=$?
 	attempts=$(wc -l <"$T/fake.log")
 	regions=$(awk '/"pass": 1/ { for (i = 1; i <= NF; i++) if ($i == "\"failed\":") print $(i + 1) + 0 }' "$T/$mode.json")
-	check "region job that ${mode}es: exit 0 and a valid image" \
+	check "region job that $what: exit 0 and a valid image" \
 		test $rc -eq 0 -a -n "$regions"
 	valid_exr "$T/$mode.exr"
-	check "region job that ${mode}es: the image is valid" test $? -eq 0
-	check "region job that ${mode}es: tried twice per region ($attempts runs, $regions failed)" \
+	check "region job that $what: the image is valid" test $? -eq 0
+	check "region job that $what: tried twice per region ($attempts runs, $regions failed)" \
 		test "$attempts" -eq $((2 * ${regions:-0})) -a "${regions:-0}" -ge 1
-	check "region job that ${mode}es: reported on stderr" grep -q "$( [ $mode = crash ] && echo crashed || echo 'timed out')" "$T/$mode.err"
+	check "region job that $what: reported on stderr" grep -q "$( [ $mode = crash ] && echo crashed || echo 'timed out')" "$T/$mode.err"
 done
 
 # --- SIGINT: children stopped, output absent or valid, --resume finishes ----
