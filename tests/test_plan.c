@@ -744,7 +744,13 @@ struct plan_input {
 	float fit[PW * PH * 3];
 };
 
-/* A flat 0.5 image; press 0 except err on the listed blocks (x0 y0 x1 y1). */
+/* A flat 0.5 image; press 0 except err on the listed blocks (x0 y0 x1 y1),
+ * whose pixels are a checkerboard of 0 and 1 (a pixel's estimate from PRESS
+ * is bounded by what its value could be off by within its neighbours'
+ * range: about 0.99 there, 0 on the flat image).  The fit is 0.5 everywhere,
+ * so a block pixel's estimate is err / (0.5^2 + 0.01) for err up to 0.25.
+ * Every pixel has scale 8 in its mask besides the base pass's 1: no hidden-
+ * edge part, and scale 2 next. */
 static void plan_input(struct plan_input *in, const int (*blocks)[4], int nblocks, float err)
 {
 	make_acc(&in->acc, PW, PH, flat_value);
@@ -752,11 +758,15 @@ static void plan_input(struct plan_input *in, const int (*blocks)[4], int nblock
 		in->press[i] = 0.0f;
 		for (int c = 0; c < 3; c++)
 			in->fit[3 * i + c] = accpx(&in->acc, (size_t)i)[c];
+		accpx(&in->acc, (size_t)i)[ACC_SCALES] = 2 + 256;
 	}
 	for (int b = 0; b < nblocks; b++)
 		for (int y = blocks[b][1]; y <= blocks[b][3]; y++)
-			for (int x = blocks[b][0]; x <= blocks[b][2]; x++)
+			for (int x = blocks[b][0]; x <= blocks[b][2]; x++) {
 				in->press[y * PW + x] = err;
+				for (int c = 0; c < 3; c++)
+					accpx(&in->acc, (size_t)y * PW + x)[c] = (float)((x + y) % 2);
+			}
 }
 
 static int in_region(const struct plan_region *r, int x, int y)
@@ -812,7 +822,7 @@ static void test_plan_make(void **state)
 	(void)state;
 	assert_non_null(in);
 	plan_params_init(&p);
-	plan_input(in, block, 1, 1.0f);
+	plan_input(in, block, 1, 0.25f);
 	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
 	assert_int_equal(pl.chosen_pixels, 30);
 	for (int y = 0; y < PH; y++)
@@ -826,7 +836,7 @@ static void test_plan_make(void **state)
 		}
 	check_regions(&pl, &p);
 	/* e = press / (0.5^2 + 0.01) on the block; scale 2 divides it by 5 */
-	double est = 30.0 * (1.0 / 0.26) / (PW * PH);
+	double est = 30.0 * (0.25 / 0.26) / (PW * PH);
 	assert_close(pl.est_relmse, est, 1e-6, 0.0, "est_relmse");
 	assert_true(pl.est_after < pl.est_relmse);
 	assert_close(pl.est_after, est / 5.0, 1e-6, 0.0, "est_after");
@@ -841,7 +851,7 @@ static void test_plan_make(void **state)
 	image_release(&in->acc);
 
 	/* a budget below one pixel's 4 samples */
-	plan_input(in, block, 1, 1.0f);
+	plan_input(in, block, 1, 0.25f);
 	p.budget = 0.5 * 4 * p.cost_sample;
 	assert_int_equal(plan_of(in, &p, &pl), PLAN_NO_BUDGET);
 	assert_int_equal(pl.nregions, 0);
@@ -850,7 +860,7 @@ static void test_plan_make(void **state)
 	image_release(&in->acc);
 
 	/* two distant blocks: one render when a job is dear, two when free */
-	plan_input(in, two, 2, 1.0f);
+	plan_input(in, two, 2, 0.25f);
 	p.cost_job = 1e3;
 	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
 	assert_int_equal(pl.nregions, 1);
@@ -886,11 +896,10 @@ static void test_plan_make(void **state)
 	image_release(&in->acc);
 
 	/* every scale already sampled everywhere, large error */
-	plan_input(in, block, 0, 0.0f);
-	for (int i = 0; i < PW * PH; i++) {
-		in->press[i] = 1.0f;
+	static const int all[1][4] = { { 0, 0, PW - 1, PH - 1 } };
+	plan_input(in, all, 1, 0.25f);
+	for (int i = 0; i < PW * PH; i++)
 		accpx(&in->acc, (size_t)i)[ACC_SCALES] = 2.0f + 4 + 16 + 256 + 65536;
-	}
 	plan_of(in, &p, &pl);
 	assert_true(pl.est_relmse > p.target);
 	assert_int_equal(pl.outcome, PLAN_NO_GAIN);
@@ -949,6 +958,7 @@ static void test_pixel_errors(void **state)
 	plan_pixel_errors(&acc, press, fit, e);
 
 	const double flat_bias = want_bias(accpx(&acc, 0)), edge_bias = want_bias(accpx(&acc, 21));
+	double got;
 	/* two rows from the edge: the edge's five differences (a plain mean
 	 * would make 0.02 of them) are a variance ratio of 5e4 away */
 	assert_close(e[1 * N + 3], 1e-6 * flat_bias, 1e-3, 0.0, "flat pixel beside the edge");
@@ -964,6 +974,32 @@ static void test_pixel_errors(void **state)
 	assert_true(flat_bias > 1.0 && flat_bias < 1.0001);
 	image_release(&acc);
 
+	/* one sample a pixel (PRESS): a dark pixel beside a lamp is charged at
+	 * most what its value could be off by within its neighbours' range */
+	make_acc(&acc, 3, 1, flat_value);
+	for (int x = 0; x < 3; x++) {
+		for (int c = 0; c < 3; c++)
+			accpx(&acc, (size_t)x)[c] = x == 2 ? 26.0f : 0.01f;
+		/* scale 8 in the mask: no hidden-edge part, PRESS alone */
+		accpx(&acc, (size_t)x)[ACC_SCALES] = 2 + 256;
+	}
+	float dfit[3] = { 0.01f, 0.01f, 0.01f };
+	/* the smoothed PRESS of the lamp's residual, relative to 0.01^2 + 0.01 */
+	got = accum_pixel_error(&acc, 1, 3.3, dfit, NAN);
+	double dh = 26.0 - 0.01, bound = dh * dh / (26.0 * 26.0 + 0.01);
+	assert_close(got, bound, 1e-5, 0.0, "dark pixel beside a lamp");
+	assert_true(got < 1.0);
+	/* the lamp itself: its range reaches down to 0.01, so PRESS stands */
+	float lfit[3] = { 20.0f, 20.0f, 20.0f };
+	got = accum_pixel_error(&acc, 2, 3.3, lfit, NAN);
+	assert_close(got, 3.3 / (20.0 * 20.0 + 0.01), 1e-5, 0.0, "the lamp");
+	/* a flat neighbourhood: nothing to be off by */
+	for (int x = 0; x < 3; x++)
+		for (int c = 0; c < 3; c++)
+			accpx(&acc, (size_t)x)[c] = 0.5f;
+	assert_true(accum_pixel_error(&acc, 1, 0.01, fit, NAN) == 0.0);
+	image_release(&acc);
+
 	/* a firefly: 5 samples of which one bright lifts the mean to 0.83;
 	 * the error relative to it hid how far off the pixel is */
 	make_acc(&acc, 1, 1, flat_value);
@@ -971,7 +1007,7 @@ static void test_pixel_errors(void **state)
 	for (int c = 0; c < 3; c++)
 		o[c] = 0.83f;
 	set_px(&acc, 0, 0, 5.0f, 2.18f, 0.05f);
-	double got = accum_pixel_error(&acc, 0, 1e-6, fit, 0.05);
+	got = accum_pixel_error(&acc, 0, 1e-6, fit, 0.05);
 	assert_close(got, 0.05 * want_bias(o), 1e-6, 0.0, "firefly");
 	assert_true(got > 2.5 * 0.05 && got < 2.8 * 0.05);
 	/* its true value estimated below a quarter of m^2: the floor */
