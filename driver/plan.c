@@ -296,9 +296,11 @@ int plan_grid_scale(const struct plan_params *p, int w, int h, int s)
 
 int plan_next_scale(const struct plan_params *p, const struct image *acc, size_t i)
 {
+	if (p->grid != PLAN_GRID_ONLY)
+		return accum_next_scale(acc, i);
 	for (int k = 0; k < ACC_NSCALES; k++) {
 		int s = accum_scales[k];
-		if (!accum_has_scale(acc, i, s) && !(s == 2 && p->grid == PLAN_GRID_ONLY))
+		if (s != 2 && !accum_has_scale(acc, i, s))
 			return s;
 	}
 	return 0;
