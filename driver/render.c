@@ -87,7 +87,7 @@ static const char usage_options[] =
 	"                        +J0.5: scale x scale jittered samples), scale\n"
 	"                        (resolution scaling throughout: the render is scale\n"
 	"                        times the size, which POV-Ray pays for per render\n"
-	"                        whatever the region), or aa (scaling, and for pixels\n"
+	"                        whatever the region), aa (scaling, and for pixels\n"
 	"                        with 21+ samples first, once per pixel, POV-Ray's\n"
 	"                        antialiasing, +AM2 +A0 +R4 +J, weighted by what it\n"
 	"                        proves worth), or jitter (no scale-2 pass: scales 4, 8\n"
