@@ -300,6 +300,15 @@ static long merge_grid(struct image *acc, const struct image *img, int oy, const
 	return count;
 }
 
+/* A region render of scale s, render_w pixels wide, of an image image_w
+ * wide: its size over the image's, ACC_GRID_FRAME for a grid render (scale
+ * 4 or more at twice the width), else accum_render_factor(s). */
+static int render_frame(int s, int render_w, int image_w)
+{
+	return s >= 4 && render_w == image_w * ACC_GRID_FRAME ? ACC_GRID_FRAME
+							       : accum_render_factor(s);
+}
+
 int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
 		       int y0, int x1, int y1, int pass, long *folded, char *err,
 		       size_t errlen)
@@ -316,8 +325,7 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 			      y0, x1, y1, acc->w, acc->h);
 		return -1;
 	}
-	const int grid = s >= 4 && img->w == acc->w * ACC_GRID_FRAME;
-	const int f = grid ? ACC_GRID_FRAME : accum_render_factor(s);
+	const int f = render_frame(s, img->w, acc->w), grid = f != accum_render_factor(s);
 	if (img->w != acc->w * f) {
 		if (s >= 4)
 			errbuf_printf(err, errlen,
@@ -399,8 +407,7 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 	if (s >= 4) {	/* a grid render or not: the render's width says */
 		if (image_exr_size(path, &w, &h, err, errlen))
 			return -1;
-		if (w == acc->w * ACC_GRID_FRAME)
-			f = ACC_GRID_FRAME;
+		f = render_frame(s, w, acc->w);
 	}
 	int rc = image_read_exr_rows(path, y0 * f, (y1 + 1) * f - 1, &img, &oy, err, errlen) ||
 		 accum_merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, folded, err, errlen);
@@ -539,20 +546,7 @@ double accum_pixel_error(const struct image *acc, size_t i, double press, const 
 			 double diff)
 {
 	const float *o = acc->px + i * ACC_NCH;
-	double den = accum_error_scale(acc, i, fit);
-	/* no estimate (a hole the regression could not reach): assume the worst
-	 * a pixel of this brightness can plausibly be off by */
-	double e = isfinite(press) ? press / den : 1.0;
-	double n = o[ACC_SAMPLES];
-	if (n < 4.0) {
-		/* PRESS is smoothed over a neighbourhood: a lamp's residual
-		 * spread onto the dark pixels around it, relative to their
-		 * darkness (hdr_highlights' base pass was estimated at 0.96
-		 * for a true relMSE of 0.018; with the bound 0.040) */
-		double rb = range_bound(acc, i);
-		if (rb < e)
-			e = rb;
-	}
+	double n = o[ACC_SAMPLES], e;
 	if (n >= 4.0 && isfinite(diff)) {
 		e = diff * value_bias(o);
 	} else if (n >= 4.0) {
@@ -562,6 +556,17 @@ double accum_pixel_error(const struct image *acc, size_t i, double press, const 
 		for (int c = 0; c < 3; c++)
 			v[c] = o[ACC_VAR_R + c] / n;
 		e = rel3(o, v) * value_bias(o);
+	} else {
+		/* no estimate (a hole the regression could not reach): assume
+		 * the worst a pixel of this brightness can plausibly be off by */
+		e = isfinite(press) ? press / accum_error_scale(acc, i, fit) : 1.0;
+		/* PRESS is smoothed over a neighbourhood: a lamp's residual
+		 * spread onto the dark pixels around it, relative to their
+		 * darkness (hdr_highlights' base pass was estimated at 0.96
+		 * for a true relMSE of 0.018; with the bound 0.040) */
+		double rb = range_bound(acc, i);
+		if (rb < e)
+			e = rb;
 	}
 	/* an edge or a detail between every sample position so far */
 	int fs = finest_scale(acc, i);

@@ -73,10 +73,11 @@ static inline int accum_render_factor(int s)
  * twice they make the mean worse than its count says and the fold
  * difference smaller than the mean's error, an estimate too low under
  * glossy_reflection's micro-bumps), so they are taken out, the pixel's mean
- * standing in for them, and the pixel gets s^2 new samples.  (Full jitter, +J, moves samples up to a
- * whole cell, out of the pixel: a wider filter than the pixel's box, which
- * at hdr_highlights' lamps made the error 4 times scale 8's.  At the
- * image's size, +R(s), the means under focal blur erred twice as much.)
+ * standing in for them, and the pixel gets s^2 new samples.  (Full jitter,
+ * +J, moves samples up to a whole cell, out of the pixel: a wider filter
+ * than the pixel's box, which at hdr_highlights' lamps made the error 4
+ * times scale 8's.  At the image's size, +R(s), the means under focal blur
+ * erred twice as much.)
  * POV-Ray holds and writes its whole frame, whose cost grows with the
  * frame's size whatever the region's (at 640x480, scale 8 writes a
  * 5120x3840 frame for about 3 CPU seconds), so a grid render costs what
@@ -128,12 +129,12 @@ int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
  * mean of their s x s blocks.  A render twice the image's size at scale 4
  * or more is a grid render (ACC_GRID_FRAME): its 2 x 2 blocks are means of
  * s^2 / 4 + 1 samples each (s^2 / 4 where the pixel has scale 2: the
- * centre sample out, see ACC_GRID_FRAME); the pixel takes their mean, the spread between
- * them, and within them the per-sample spread their spread implies for
- * noise, but not more than the pixel's samples had so far (spread between
- * the sub-pixels can be an edge's, not noise).  *folded counts the pixels
- * that took new samples (may be NULL).  Fails on a size mismatch or rows
- * not read.
+ * centre sample out, see ACC_GRID_FRAME); the pixel takes their mean, the
+ * spread between them, and within them the per-sample spread their spread
+ * implies for noise, but not more than the pixel's samples had so far
+ * (spread between the sub-pixels can be an edge's, not noise).  *folded
+ * counts the pixels that took new samples (may be NULL).  Fails on a size
+ * mismatch or rows not read.
  */
 int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
 		       int y0, int x1, int y1, int pass, long *folded, char *err,

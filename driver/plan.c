@@ -56,20 +56,20 @@ static double mean_var(const float *o)
 }
 
 /*
- * The 'diff' estimate of pixel i averaged over the 5x5 pixels around it
- * that have one (a single pixel's is a difference of two noisy means:
+ * The 'diff' estimate of pixel (x, y) averaged over the 5x5 pixels around
+ * it that have one (a single pixel's is a difference of two noisy means:
  * about three degrees of freedom); NaN when none has.  A neighbour counts
  * by how alike the two pixels' sample variances are (of their means,
- * relative): with weight exp(-ln^2(v_j / v_i) / 2), so a factor e apart
- * 0.61, ten apart 0.07.  A plain mean spread one pixel's difference over
- * all 25: the horizon's (a sky/floor edge whose coarse samples all fell on
- * the floor) put 0.035 on the flat sky rows beside it, a quarter of
- * soft_shadows' whole estimate at --target 3e-3, and the thin rods' onto
- * the background around them.
+ * relative; mv holds every pixel's mean_var()): with weight
+ * exp(-ln^2(v_j / v_i) / 2), so a factor e apart 0.61, ten apart 0.07.  A
+ * plain mean spread one pixel's difference over all 25: the horizon's (a
+ * sky/floor edge whose coarse samples all fell on the floor) put 0.035 on
+ * the flat sky rows beside it, a quarter of soft_shadows' whole estimate at
+ * --target 3e-3, and the thin rods' onto the background around them.
  */
-static double diff_around(const struct image *acc, int x, int y)
+static double diff_around(const struct image *acc, const double *mv, int x, int y)
 {
-	const double vi = mean_var(acc->px + ((size_t)y * acc->w + x) * ACC_NCH);
+	const double vi = mv[(size_t)y * acc->w + x];
 	double sum = 0.0, wsum = 0.0;
 	for (int j = y - DIFF_RADIUS; j <= y + DIFF_RADIUS; j++) {
 		if (j < 0 || j >= acc->h)
@@ -77,30 +77,41 @@ static double diff_around(const struct image *acc, int x, int y)
 		for (int k = x - DIFF_RADIUS; k <= x + DIFF_RADIUS; k++) {
 			if (k < 0 || k >= acc->w)
 				continue;
-			const float *q = acc->px + ((size_t)j * acc->w + k) * ACC_NCH;
-			if (!isfinite(q[ACC_DIFF]))
+			const size_t q = (size_t)j * acc->w + k;
+			const float d = acc->px[q * ACC_NCH + ACC_DIFF];
+			if (!isfinite(d))
 				continue;
-			double l = log(mean_var(q) / vi), wt = exp(-0.5 * l * l);
-			sum += wt * q[ACC_DIFF];
+			double l = log(mv[q] / vi), wt = exp(-0.5 * l * l);
+			sum += wt * d;
 			wsum += wt;
 		}
 	}
 	return wsum > 0.0 ? sum / wsum : NAN;
 }
 
-double plan_pixel_errors(const struct image *acc, const float *press, const float *fit,
-			 double *e)
+int plan_pixel_errors(const struct image *acc, const float *press, const float *fit,
+		      double *e, double *est, char *err, size_t errlen)
 {
 	size_t n = (size_t)acc->w * acc->h;
+	double *mv = malloc((n ? n : 1) * sizeof(*mv));
+	if (!mv) {
+		errbuf_printf(err, errlen, "out of memory estimating a %dx%d image's errors",
+			      acc->w, acc->h);
+		return -1;
+	}
+	for (size_t i = 0; i < n; i++)
+		mv[i] = mean_var(acc->px + i * ACC_NCH);
 	double sum = 0.0;
 	for (size_t i = 0; i < n; i++) {
 		const float *o = acc->px + i * ACC_NCH;
 		double diff = isfinite(o[ACC_DIFF]) ?
-			diff_around(acc, (int)(i % (size_t)acc->w), (int)(i / (size_t)acc->w)) : NAN;
+			diff_around(acc, mv, (int)(i % (size_t)acc->w), (int)(i / (size_t)acc->w)) : NAN;
 		e[i] = accum_pixel_error(acc, i, press[i], fit + 3 * i, diff);
 		sum += e[i];
 	}
-	return n ? sum / n : 0.0;
+	free(mv);
+	*est = n ? sum / n : 0.0;
+	return 0;
 }
 
 struct cand {
@@ -288,6 +299,22 @@ out:
 	return ret;
 }
 
+static const char *const grid_names[] = { "scale", "grid", "auto", "jitter" };
+#define NGRID (int)(sizeof(grid_names) / sizeof(grid_names[0]))
+
+const char *plan_grid_name(int grid)
+{
+	return grid >= 0 && grid < NGRID ? grid_names[grid] : "?";
+}
+
+int plan_grid_parse(const char *name)
+{
+	for (int k = 0; k < NGRID; k++)
+		if (!strcmp(name, grid_names[k]))
+			return k;
+	return -1;
+}
+
 int plan_grid_scale(const struct plan_params *p, int w, int h, int s)
 {
 	return s >= 4 && (p->grid == PLAN_GRID_ALWAYS || p->grid == PLAN_GRID_ONLY ||
@@ -337,8 +364,12 @@ int plan_make(const struct image *acc, const float *press, const float *fit,
 		errbuf_printf(err, errlen, "out of memory planning a %dx%d image", acc->w, acc->h);
 		return -1;
 	}
-	plan_pixel_errors(acc, press, fit, e);
-	int rc = plan_make_from(acc, e, p, out, err, errlen);
+	double est;
+	int rc = plan_pixel_errors(acc, press, fit, e, &est, err, errlen);
+	if (rc)
+		memset(out, 0, sizeof(*out));
+	else
+		rc = plan_make_from(acc, e, p, out, err, errlen);
 	free(e);
 	return rc;
 }

@@ -49,6 +49,12 @@ struct plan_params {
 enum { PLAN_GRID_NEVER, PLAN_GRID_ALWAYS, PLAN_GRID_LARGE, PLAN_GRID_ONLY };
 #define PLAN_GRID_FRAME (1024.0 * 1024.0)
 
+/* The --sampler names of PLAN_GRID_NEVER, _ALWAYS, _LARGE and _ONLY:
+ * "scale", "grid", "auto", "jitter".  plan_grid_parse() returns the mode
+ * a name gives, -1 for another name. */
+const char *plan_grid_name(int grid);
+int plan_grid_parse(const char *name);
+
 /* Whether scale s of a w x h image is rendered as a grid render. */
 int plan_grid_scale(const struct plan_params *p, int w, int h, int s);
 
@@ -97,10 +103,11 @@ const char *plan_outcome_name(enum plan_outcome o);
 /*
  * Estimated relative error of every pixel (w*h doubles into e) from the
  * analysis (error and fit, as lpr_result or `povpress analyze` give them)
- * and the accumulation; returns the image relMSE estimate (their mean).
+ * and the accumulation, and in *est the image relMSE estimate (their
+ * mean).  Returns 0, or -1 out of memory (err says so).
  */
-double plan_pixel_errors(const struct image *acc, const float *press, const float *fit,
-			 double *e);
+int plan_pixel_errors(const struct image *acc, const float *press, const float *fit,
+		      double *e, double *est, char *err, size_t errlen);
 
 /* Plan one pass from the pixels' estimated errors e (plan_pixel_errors()). */
 int plan_make_from(const struct image *acc, const double *e, const struct plan_params *p,

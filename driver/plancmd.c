@@ -157,15 +157,7 @@ int cmd_plan(int argc, char **argv)
 				goto bad;
 		} else if (!strcmp(a, "--sampler")) {
 			const char *m = argv[++i];
-			if (!strcmp(m, "auto")) {
-				pp.grid = PLAN_GRID_LARGE;
-			} else if (!strcmp(m, "grid")) {
-				pp.grid = PLAN_GRID_ALWAYS;
-			} else if (!strcmp(m, "scale")) {
-				pp.grid = PLAN_GRID_NEVER;
-			} else if (!strcmp(m, "jitter")) {
-				pp.grid = PLAN_GRID_ONLY;
-			} else {
+			if ((pp.grid = plan_grid_parse(m)) < 0) {
 				fprintf(stderr,
 					"povpress plan: --sampler takes auto, grid, scale or jitter, not '%s'\n",
 					m);

@@ -142,7 +142,9 @@ struct run {
 	double target, budget, timeout;
 	double user_cost_job, user_cost_sample;	/* 0: measure */
 	int user_rad_scale;	/* --radiosity-scale: -1 choose, 0 no radiosity pass */
-	int sampler;		/* --sampler: SAMPLER_* */
+	int grid;		/* --sampler: which scales are grid renders,
+				 * PLAN_GRID_* (plan.h) */
+	int aa;			/* --sampler aa (grid PLAN_GRID_NEVER) */
 	enum accum_final final;
 	const char *const *extra;
 	size_t nextra;
@@ -163,9 +165,6 @@ struct run {
 	/* progress while a pool runs */
 	int pool_done, pool_total, pool_pass;
 };
-
-enum { SAMPLER_SCALE, SAMPLER_AA, SAMPLER_GRID, SAMPLER_AUTO, SAMPLER_JITTER, NSAMPLERS };
-static const char *const sampler_names[NSAMPLERS] = { "scale", "aa", "grid", "auto", "jitter" };
 
 static void print_usage(FILE *f)
 {
@@ -438,7 +437,7 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 	fprintf(f, ",\n  \"cost_model\": {\"job_s\": %.17g, \"sample_s\": %.17g, "
 		"\"latency_s\": %.6g},\n  \"radiosity\": %s,\n  \"radiosity_scale\": %d,\n"
 		"  \"sampler\": \"%s\",\n  \"passes\": [\n", r->cost_job, r->cost_sample,
-		r->latency, r->radiosity ? "true" : "false", r->rad_scale, sampler_names[r->sampler]);
+		r->latency, r->radiosity ? "true" : "false", r->rad_scale, r->aa ? "aa" : plan_grid_name(r->grid));
 	for (size_t k = 0; k < r->npasses; k++) {
 		const struct pass_rec *p = &r->passes[k];
 		fprintf(f, "    {\"pass\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, "
@@ -713,7 +712,7 @@ static long lacking_aa(const struct run *r, const struct plan_region *g)
  */
 static void choose_samplers(const struct run *r, struct plan *pl)
 {
-	if (r->sampler != SAMPLER_AA)
+	if (!r->aa)
 		return;
 	size_t m = 0;
 	for (size_t k = 0; k < pl->nregions; k++) {
@@ -745,10 +744,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	pp.cost_job = r->cost_job;
 	pp.cost_sample = r->cost_sample;
 	pp.max_regions = r->jobs > 8 ? r->jobs : 8;
-	pp.grid = r->sampler == SAMPLER_GRID	 ? PLAN_GRID_ALWAYS
-		  : r->sampler == SAMPLER_AUTO	 ? PLAN_GRID_LARGE
-		  : r->sampler == SAMPLER_JITTER ? PLAN_GRID_ONLY
-						 : PLAN_GRID_NEVER;
+	pp.grid = r->grid;
 	if (r->budget > 0.0) {
 		double left = r->budget - elapsed(r);
 		/* in core-seconds, keeping a share for the analysis and the
@@ -932,7 +928,7 @@ int cmd_render(int argc, char **argv)
 	r.final = ACC_FINAL_SAMPLES;
 	r.rad_scale = 1;
 	r.user_rad_scale = -1;
-	r.sampler = SAMPLER_AUTO;
+	r.grid = PLAN_GRID_LARGE;
 	char emap[PATH_MAX], wdir[PATH_MAX];
 
 	int i = 1;
@@ -999,12 +995,10 @@ int cmd_render(int argc, char **argv)
 			r.report = argv[++i];
 		} else if (!strcmp(a, "--sampler")) {
 			const char *m = argv[++i];
-			int k = 0;
-			while (k < NSAMPLERS && strcmp(m, sampler_names[k]))
-				k++;
-			if (k == NSAMPLERS)
+			r.aa = !strcmp(m, "aa");
+			r.grid = r.aa ? PLAN_GRID_NEVER : plan_grid_parse(m);
+			if (r.grid < 0)
 				goto bad;
-			r.sampler = k;
 		} else if (!strcmp(a, "--final")) {
 			const char *m = argv[++i];
 			if (!strcmp(m, "auto"))
@@ -1157,7 +1151,9 @@ bad:
 		if (analyse(&r, &res, err, sizeof err))
 			goto fail;
 		size_t npx = (size_t)r.w * r.h;
-		double est = plan_pixel_errors(&r.acc, res.error, res.fit, r.est);
+		double est;
+		if (plan_pixel_errors(&r.acc, res.error, res.fit, r.est, &est, err, sizeof err))
+			goto fail;
 		long left = 0;
 		for (size_t k = 0; k < npx; k++)
 			left += r.est[k] > r.target;

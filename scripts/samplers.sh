@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# samplers.sh - `povpress render --sampler auto|grid|scale|aa` side by side.
+# samplers.sh - `povpress render --sampler auto|grid|scale|aa|jitter` side by side.
 #
 # usage: scripts/samplers.sh [BUILD_DIR] [SCENE ...]
 #
