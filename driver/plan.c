@@ -333,6 +333,240 @@ int plan_next_scale(const struct plan_params *p, const struct image *acc, size_t
 	return 0;
 }
 
+/* The first scale past cur that pixel i may be refined at in a pass:
+ * unused, at most smax, and not 2 under PLAN_GRID_ONLY; 0 if none. */
+static int scale_after(const struct plan_params *p, const struct image *acc, size_t i, int cur,
+		       int smax)
+{
+	for (int k = 0; k < ACC_NSCALES; k++) {
+		int s = accum_scales[k];
+		if (s <= cur || (s == 2 && p->grid == PLAN_GRID_ONLY) || accum_has_scale(acc, i, s))
+			continue;
+		return s <= smax ? s : 0;
+	}
+	return 0;
+}
+
+/* Taking a pixel from scale `from` on to `to` in this pass: what it gains
+ * and costs more, and the gain per cost, in a max-heap of upgrades. */
+struct upgrade {
+	size_t i;
+	int to;
+	double gain, cost, score;
+};
+
+static int upgrade_before(const struct upgrade *a, const struct upgrade *b)
+{
+	if (a->score != b->score)
+		return a->score > b->score;
+	return a->i < b->i;	/* the same plan every run */
+}
+
+static void heap_push(struct upgrade *h, size_t *n, struct upgrade u)
+{
+	size_t k = (*n)++;
+	while (k > 0 && upgrade_before(&u, &h[(k - 1) / 2])) {
+		h[k] = h[(k - 1) / 2];
+		k = (k - 1) / 2;
+	}
+	h[k] = u;
+}
+
+static struct upgrade heap_pop(struct upgrade *h, size_t *n)
+{
+	struct upgrade top = h[0], last = h[--*n];
+	size_t k = 0;
+	for (;;) {
+		size_t c = 2 * k + 1;
+		if (c >= *n)
+			break;
+		if (c + 1 < *n && upgrade_before(&h[c + 1], &h[c]))
+			c++;
+		if (!upgrade_before(&h[c], &last))
+			break;
+		h[k] = h[c];
+		k = c;
+	}
+	if (*n)
+		h[k] = last;
+	return top;
+}
+
+/* The upgrade of pixel i (error e, n samples) from scale cur to the next
+ * it may take; 0 when there is none. */
+static int next_upgrade(const struct plan_params *p, const struct image *acc, size_t i, double e,
+			int cur, int smax, struct upgrade *u)
+{
+	int to = scale_after(p, acc, i, cur, smax);
+	if (!to)
+		return 0;
+	double n = acc->px[i * ACC_NCH + ACC_SAMPLES];
+	double m1 = (double)cur * cur, m2 = (double)to * to;
+	u->i = i;
+	u->to = to;
+	u->gain = e * (m2 / (n + m2) - m1 / (n + m1));
+	u->cost = p->cost_sample * (m2 - m1);
+	u->score = u->gain / u->cost;
+	return 1;
+}
+
+/* Pixels of region r that its scale was planned for (ps), and their gain. */
+static void region_count(const struct plan_region *r, int w, const unsigned char *ps,
+			 const double *gain, struct plan_region *o)
+{
+	o->chosen = 0;
+	o->gain = 0.0;
+	for (int y = r->y0; y <= r->y1; y++)
+		for (int x = r->x0; x <= r->x1; x++) {
+			size_t i = (size_t)y * w + x;
+			if (ps[i] == r->scale) {
+				o->chosen++;
+				o->gain += gain[i];
+			}
+		}
+}
+
+/*
+ * Split the dearest region in two across its longer side while it costs
+ * more than the pass over p->min_split, renders more than four
+ * invocations' worth of samples, and the plan has fewer than
+ * p->max_regions: so that the cores finish together.  Returns 0, -1 when
+ * out of memory.
+ */
+static int split_regions(const struct plan_params *p, struct plan *out, const unsigned char *ps,
+			 const double *gain)
+{
+	if (p->min_split < 2)
+		return 0;
+	double total = 0.0;
+	for (size_t k = 0; k < out->nregions; k++)
+		total += out->regions[k].cost;
+	while (out->nregions < (size_t)p->max_regions) {
+		size_t d = 0;
+		for (size_t k = 1; k < out->nregions; k++)
+			if (out->regions[k].cost > out->regions[d].cost)
+				d = k;
+		struct plan_region a = out->regions[d], b = a;
+		int rw = a.x1 - a.x0 + 1, rh = a.y1 - a.y0 + 1;
+		if (a.cost <= total / p->min_split || a.cost - p->cost_job < 4.0 * p->cost_job ||
+		    (rw < 2 && rh < 2))
+			break;
+		if (rh >= rw) {
+			a.y1 = a.y0 + rh / 2 - 1;
+			b.y0 = a.y1 + 1;
+		} else {
+			a.x1 = a.x0 + rw / 2 - 1;
+			b.x0 = a.x1 + 1;
+		}
+		region_count(&a, out->w, ps, gain, &a);
+		region_count(&b, out->w, ps, gain, &b);
+		a.cost = rect_cost(p, &a);
+		b.cost = rect_cost(p, &b);
+		void *q = realloc(out->regions, (out->nregions + 1) * sizeof(*out->regions));
+		if (!q)
+			return -1;
+		out->regions = q;
+		out->regions[d] = a;
+		out->regions[out->nregions++] = b;
+		total += p->cost_job;
+	}
+	return 0;
+}
+
+/* A band of a rectangle, for fit_budget(). */
+struct band {
+	struct plan_region r;
+	size_t parent, seq;
+	int keep;
+};
+
+static int band_by_value(const void *a, const void *b)
+{
+	const struct band *x = a, *y = b;
+	double vx = x->r.gain / x->r.cost, vy = y->r.gain / y->r.cost;
+	if (vx != vy)
+		return vx < vy ? 1 : -1;
+	if (x->parent != y->parent)
+		return x->parent < y->parent ? -1 : 1;
+	return x->seq < y->seq ? -1 : x->seq > y->seq;
+}
+
+static int band_by_place(const void *a, const void *b)
+{
+	const struct band *x = a, *y = b;
+	if (x->parent != y->parent)
+		return x->parent < y->parent ? -1 : 1;
+	return x->seq < y->seq ? -1 : x->seq > y->seq;
+}
+
+/*
+ * Rectangles costing more than the budget together: cut them into bands of
+ * p->tile rows, keep the bands worth most per cost that fit, and join again
+ * the kept bands of a rectangle that touch, so that what goes is the least
+ * worth, not whole rectangles.  Returns 0, -1 when out of memory.
+ */
+static int fit_budget(const struct plan_params *p, struct plan *out, const unsigned char *ps,
+		      const double *gain)
+{
+	double c = 0.0;
+	size_t nb = 0;
+	for (size_t k = 0; k < out->nregions; k++) {
+		c += out->regions[k].cost;
+		nb += (size_t)((out->regions[k].y1 - out->regions[k].y0) / p->tile + 1);
+	}
+	if (!(p->budget > 0.0) || c <= p->budget)
+		return 0;
+	struct band *b = malloc(nb * sizeof(*b));
+	if (!b)
+		return -1;
+	nb = 0;
+	for (size_t k = 0; k < out->nregions; k++) {
+		const struct plan_region *r = &out->regions[k];
+		for (int y = r->y0, q = 0; y <= r->y1; y += p->tile, q++) {
+			struct band *d = &b[nb++];
+			d->r = *r;
+			d->r.y0 = y;
+			d->r.y1 = y + p->tile - 1 < r->y1 ? y + p->tile - 1 : r->y1;
+			region_count(&d->r, out->w, ps, gain, &d->r);
+			d->r.cost = rect_cost(p, &d->r);
+			d->parent = k;
+			d->seq = (size_t)q;
+			d->keep = 0;
+		}
+	}
+	qsort(b, nb, sizeof(*b), band_by_value);
+	c = 0.0;
+	for (size_t k = 0; k < nb; k++)
+		if (b[k].r.gain > 0.0 && c + b[k].r.cost <= p->budget) {
+			b[k].keep = 1;
+			c += b[k].r.cost;
+		}
+	qsort(b, nb, sizeof(*b), band_by_place);
+	void *q = realloc(out->regions, nb * sizeof(*out->regions));
+	if (!q) {
+		free(b);
+		return -1;
+	}
+	out->regions = q;
+	size_t n = 0;
+	for (size_t k = 0; k < nb; k++) {
+		if (!b[k].keep)
+			continue;
+		if (n && b[k - 1].keep && b[k - 1].parent == b[k].parent) {
+			struct plan_region *m = &out->regions[n - 1];
+			m->y1 = b[k].r.y1;
+			m->chosen += b[k].r.chosen;
+			m->gain += b[k].r.gain;
+			m->cost = rect_cost(p, m);
+		} else {
+			out->regions[n++] = b[k].r;
+		}
+	}
+	out->nregions = n;
+	free(b);
+	return 0;
+}
+
 static int by_value(const void *a, const void *b)
 {
 	const struct plan_region *x = a, *y = b;
@@ -381,7 +615,8 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	const size_t npx = (size_t)w * h;
 	double *gain = NULL;
 	struct cand *cand = NULL;
-	unsigned char *mark = NULL;
+	unsigned char *mark = NULL, *ps = NULL;
+	struct upgrade *heap = NULL;
 	int ret = -1;
 
 	memset(out, 0, sizeof(*out));
@@ -395,9 +630,10 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	gain = calloc(npx, sizeof(*gain));
 	cand = malloc(npx * sizeof(*cand));
 	mark = malloc(npx);
+	ps = calloc(npx, 1);
 	out->scale = calloc(npx, sizeof(float));
 	out->chosen = calloc(npx, sizeof(float));
-	if (!gain || !cand || !mark || !out->scale || !out->chosen) {
+	if (!gain || !cand || !mark || !ps || !out->scale || !out->chosen) {
 		errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
 		goto out;
 	}
@@ -434,20 +670,115 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	}
 	qsort(cand, nc, sizeof(*cand), by_score);
 
-	/* take pixels until the predicted error meets target * margin or the
-	 * samples alone would exceed the budget */
-	double total = out->est_relmse * (double)npx, goal = p->target * p->margin * (double)npx;
-	double spend = 0.0;
+	/*
+	 * Take pixels at their next scales until the predicted error meets
+	 * target * margin or the samples alone would exceed the budget.  Then,
+	 * in a pass that may be the last (p->fill), with the goal unmet and
+	 * the share of the budget unspent, take the chosen pixels on to later
+	 * scales, the best gain per cost first.  The rectangles cost more than
+	 * the pixels (they cover their neighbours too): while they would cost
+	 * more than the budget, or than the share allows, the choice is made
+	 * again with less to spend.
+	 */
+	const double goal = p->target * p->margin * (double)npx;
+	const double limit = p->fill > 0.0 && (p->budget <= 0.0 || 1.25 * p->fill < p->budget)
+				     ? 1.25 * p->fill
+				     : p->budget;
+	const double cap = p->budget > 0.0 ? p->budget : INFINITY;
+	double upto = p->fill < cap ? p->fill : cap, lo = -1.0, hi = INFINITY;
 	size_t taken = 0;
-	for (; taken < nc && total > goal; taken++) {
-		size_t i = cand[taken].i;
-		int s = plan_next_scale(p, acc, i);
-		double c = p->cost_sample * s * s;
-		if (p->budget > 0.0 && spend + c > p->budget)
+	for (int attempt = 0;; attempt++) {
+		double total = out->est_relmse * (double)npx, spend = 0.0;
+		for (size_t t = 0; t < taken; t++) {
+			ps[cand[t].i] = 0;
+			gain[cand[t].i] = 0.0;
+		}
+		free(out->regions);
+		out->regions = NULL;
+		out->nregions = 0;
+		for (taken = 0; taken < nc && total > goal; taken++) {
+			size_t i = cand[taken].i;
+			int s = plan_next_scale(p, acc, i);
+			double c = p->cost_sample * s * s;
+			if (spend + c > cap)
+				break;
+			spend += c;
+			total -= cand[taken].gain;
+			gain[i] = cand[taken].gain;
+			ps[i] = (unsigned char)s;
+		}
+		if (!taken)
 			break;
-		spend += c;
-		total -= cand[taken].gain;
-		gain[i] = cand[taken].gain;
+		const double spend0 = spend;
+		if (total > goal && spend < upto) {
+			if (!heap && !(heap = malloc(nc * sizeof(*heap)))) {
+				errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
+				goto out;
+			}
+			size_t nh = 0;
+			for (size_t t = 0; t < taken; t++) {
+				struct upgrade u;
+				size_t i = cand[t].i;
+				if (next_upgrade(p, acc, i, e[i], ps[i], smax, &u))
+					heap_push(heap, &nh, u);
+			}
+			while (nh && total > goal && spend < upto) {
+				struct upgrade u = heap_pop(heap, &nh);
+				if (spend + u.cost > upto)
+					continue;
+				spend += u.cost;
+				total -= u.gain;
+				gain[u.i] += u.gain;
+				ps[u.i] = (unsigned char)u.to;
+				if (next_upgrade(p, acc, u.i, e[u.i], u.to, smax, &u))
+					heap_push(heap, &nh, u);
+			}
+		}
+
+		/* pack per scale */
+		for (int k = 0; k < ACC_NSCALES; k++) {
+			int s = accum_scales[k], any = 0;
+			memset(mark, 0, npx);
+			for (size_t t = 0; t < taken; t++) {
+				size_t i = cand[t].i;
+				if (ps[i] == s) {
+					mark[i] = 1;
+					any = 1;
+				}
+			}
+			if (!any)
+				continue;
+			int rc, tile = p->tile;
+			while ((rc = pack(p, w, h, s, mark, gain, tile, p->max_regions,
+					  &out->regions, &out->nregions)) == 1)
+				tile *= 2;
+			if (rc) {
+				errbuf_printf(err, errlen, "out of memory packing regions");
+				goto out;
+			}
+		}
+		double c = 0.0;
+		for (size_t k = 0; k < out->nregions; k++)
+			c += out->regions[k].cost;
+		if (spend == spend0 || attempt == 7)
+			break;
+		/* again with fewer upgrades: a bisection of what they may spend
+		 * between a share that fit and one that did not */
+		if (lo < 0.0)
+			lo = spend0;
+		if (c <= limit) {
+			lo = upto;
+			if (hi == INFINITY || hi - lo < 0.1 * hi || attempt >= 6)
+				break;
+		} else {
+			hi = upto;
+		}
+		if (attempt >= 6)
+			upto = lo;	/* the last attempt: the most that fit */
+		else if (lo == spend0)
+			upto = spend0 + (spend - spend0) * 0.8 * limit / c;
+		else
+			upto = 0.5 * (lo + hi);
 	}
 	if (!taken) {
 		out->outcome = nc ? PLAN_NO_BUDGET : PLAN_NO_GAIN;
@@ -455,30 +786,12 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 		goto out;
 	}
 
-	/* pack per scale */
-	for (int k = 0; k < ACC_NSCALES; k++) {
-		int s = accum_scales[k], any = 0;
-		memset(mark, 0, npx);
-		for (size_t t = 0; t < taken; t++) {
-			size_t i = cand[t].i;
-			if (plan_next_scale(p, acc, i) == s) {
-				mark[i] = 1;
-				any = 1;
-			}
-		}
-		if (!any)
-			continue;
-		int rc, tile = p->tile;
-		while ((rc = pack(p, w, h, s, mark, gain, tile, p->max_regions, &out->regions,
-				  &out->nregions)) == 1)
-			tile *= 2;
-		if (rc) {
-			errbuf_printf(err, errlen, "out of memory packing regions");
-			goto out;
-		}
+	/* over the budget: the least worth goes; over the cap or still over
+	 * the budget: the regions worth least per cost */
+	if (fit_budget(p, out, ps, gain)) {
+		errbuf_printf(err, errlen, "out of memory packing regions");
+		goto out;
 	}
-
-	/* over the cap or the budget: drop the regions worth least per cost */
 	qsort(out->regions, out->nregions, sizeof(*out->regions), by_value);
 	while (out->nregions > (size_t)p->max_regions)
 		out->nregions--;
@@ -495,6 +808,10 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	if (!out->nregions) {
 		out->outcome = PLAN_NO_BUDGET;
 		ret = 0;
+		goto out;
+	}
+	if (split_regions(p, out, ps, gain)) {
+		errbuf_printf(err, errlen, "out of memory packing regions");
 		goto out;
 	}
 	qsort(out->regions, out->nregions, sizeof(*out->regions), by_position);
@@ -535,6 +852,8 @@ out:
 	free(gain);
 	free(cand);
 	free(mark);
+	free(ps);
+	free(heap);
 	if (ret)
 		plan_release(out);
 	return ret;

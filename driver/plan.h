@@ -40,6 +40,15 @@ struct plan_params {
 				 * is not refined (default 0.05) */
 	int grid;		/* which of scales 4, 8, 16 are grid renders
 				 * (accum.h): PLAN_GRID_* (default NEVER) */
+	double fill;		/* when the pixels at their next scales leave
+				 * the goal unmet and cost less than this, take
+				 * chosen pixels on to later scales until the
+				 * samples cost this much (seconds; default 0:
+				 * never).  For a pass that may be the last. */
+	int min_split;		/* split the dearest regions in two, up to
+				 * max_regions, until none costs more than the
+				 * pass over min_split (the cores that render
+				 * it at once; default 0: no splitting) */
 };
 
 /* Grid renders: never (resolution scaling), for every scale of 4 or more,

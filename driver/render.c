@@ -754,7 +754,15 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			r->stop = "budget spent";
 			return PASS_STOP;
 		}
+		/* the passes that still fit, each waiting on POV-Ray's latency
+		 * and the analysis: when only one or two do, this pass takes
+		 * its share of the budget even past the pixels' next scales */
+		double over = r->latency + r->passes[r->npasses - 1].analysis_s + 0.1;
+		int fit = (int)((left - 0.2) / over);
+		if (fit <= 2)
+			pp.fill = fit <= 1 ? pp.budget : pp.budget / fit;
 	}
+	pp.min_split = r->cores;
 	struct plan pl;
 	if (plan_make_from(&r->acc, r->est, &pp, &pl, err, errlen))
 		return -1;

@@ -911,6 +911,108 @@ static void test_plan_make(void **state)
 
 /* The factor value_bias() puts on a pixel's relative error (accum.c): mean
  * over R, G, B of m^2 + 0.01 over that of max(m^2 - var / n, m^2 / 4) + 0.01. */
+/* The cost of a plan's regions as rect_cost() has it. */
+static double plan_cost(const struct plan *pl, const struct plan_params *p)
+{
+	double c = 0.0;
+
+	for (size_t k = 0; k < pl->nregions; k++) {
+		const struct plan_region *r = &pl->regions[k];
+		double area = (double)(r->x1 - r->x0 + 1) * (r->y1 - r->y0 + 1);
+
+		c += p->cost_job + p->cost_sample * area * r->scale * r->scale;
+	}
+	return c;
+}
+
+/* 7. A pass that may be the last takes its pixels past their next scale;
+ * a budget below the rectangles keeps their best bands; the dearest
+ * region is split for the cores. */
+static void test_plan_budget(void **state)
+{
+	static const int block[1][4] = { { 20, 17, 25, 21 } };	/* 6 x 5 */
+	static const int all[1][4] = { { 0, 0, PW - 1, PH - 1 } };
+	struct plan_input *in = malloc(sizeof(*in));
+	struct plan_params p;
+	struct plan pl;
+
+	(void)state;
+	assert_non_null(in);
+	plan_params_init(&p);
+	p.target = 1e-6;
+	p.budget = 0.2;
+	plan_input(in, block, 1, 0.25f);
+	/* without fill: scale 2, the next */
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	double est = pl.est_relmse, after2 = pl.est_after;
+	check_regions(&pl, &p);
+	plan_release(&pl);
+	/* filling the budget: the block's pixels go to scale 16 (8 is done),
+	 * 256 samples each, in one region within the budget */
+	p.fill = p.budget;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	assert_int_equal(pl.chosen_pixels, 30);
+	for (size_t k = 0; k < pl.nregions; k++)
+		assert_int_equal(pl.regions[k].scale, 16);
+	for (int y = 17; y <= 21; y++)
+		for (int x = 20; x <= 25; x++)
+			assert_true(pl.scale[y * PW + x] == 16.0f);
+	assert_true(plan_cost(&pl, &p) <= p.budget);
+	assert_close(pl.est_after, est / 257.0, 1e-6, 0.0, "est_after at scale 16");
+	assert_true(pl.est_after < after2);
+	plan_release(&pl);
+	/* a fill below scale 16's cost: scale 4 for some, within 1.25 fill */
+	p.fill = 0.05 + 30 * 16 * p.cost_sample;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	int up = 0;
+	for (size_t k = 0; k < pl.nregions; k++)
+		up |= pl.regions[k].scale > 2;
+	assert_true(up);
+	assert_true(plan_cost(&pl, &p) <= 1.25 * p.fill);
+	assert_true(pl.est_after < after2);
+	plan_release(&pl);
+	image_release(&in->acc);
+	plan_params_init(&p);
+
+	/* rows 0-15 with five times the error of the rest: at 0.001 + 8e-6 per
+	 * pixel and a budget of 0.015 the pixels chosen (rows 0-15, then rows
+	 * 16-29 by position) make one rectangle over the budget (0.0164); it
+	 * keeps the bands of 8 rows worth most, rows 0-15, and what else fits */
+	plan_input(in, all, 1, 0.05f);
+	for (int y = 0; y < 16; y++)
+		for (int x = 0; x < PW; x++)
+			in->press[y * PW + x] = 0.25f;
+	p.target = 1e-6;
+	p.cost_job = 0.001;
+	p.budget = 0.015;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	check_regions(&pl, &p);
+	assert_true(plan_cost(&pl, &p) <= p.budget);
+	for (int y = 0; y < 16; y++)
+		for (int x = 0; x < PW; x++)
+			assert_true(pl.scale[y * PW + x] == 2.0f);
+	assert_true(pl.pixels < 30 * PW);
+	plan_release(&pl);
+
+	/* no budget, two cores: the frame in two halves of equal cost */
+	p.budget = 0.0;
+	p.min_split = 2;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	check_regions(&pl, &p);
+	assert_int_equal(pl.nregions, 2);
+	assert_int_equal(pl.pixels, PW * PH);
+	assert_int_equal(pl.chosen_pixels, PW * PH);
+	assert_close(pl.regions[0].cost, pl.regions[1].cost, 1e-9, 0.0, "halves' costs");
+	plan_release(&pl);
+	/* ... and none when the cores are one */
+	p.min_split = 1;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	assert_int_equal(pl.nregions, 1);
+	plan_release(&pl);
+	image_release(&in->acc);
+	free(in);
+}
+
 static double want_bias(const float *o)
 {
 	double a = 0.0, b = 0.0;
@@ -1238,6 +1340,7 @@ int main(void)
 		cmocka_unit_test(test_accum_read),
 		cmocka_unit_test(test_read_rows),
 		cmocka_unit_test(test_plan_make),
+		cmocka_unit_test(test_plan_budget),
 		cmocka_unit_test(test_pixel_errors),
 		cmocka_unit_test(test_regions_file),
 		cmocka_unit_test(test_plan_job),
