@@ -46,6 +46,7 @@
 #include <unistd.h>
 #ifdef __linux__
 #include <sys/prctl.h>
+#include <sys/inotify.h>
 #endif
 
 #define POV_LOG_MAX (1u << 20)	/* console output kept per attempt (its tail) */
@@ -1186,6 +1187,9 @@ struct pjob {
 	double start, deadline, kill_at;
 	int stop;		/* STOP_*: why the pool is stopping it */
 	int killed;		/* SIGKILL sent */
+	int early;		/* its output was whole before it exited: the
+				 * pool killed it */
+	int wd;			/* inotify watch of its output's directory */
 	struct buf log;
 };
 
@@ -1318,6 +1322,7 @@ static int spawn(struct pjob *j, int devnull, double t0, struct pov_result *res)
 	j->state = J_RUNNING;
 	j->stop = STOP_NONE;
 	j->killed = 0;
+	j->early = 0;
 	j->kill_at = 0;
 	j->log.len = 0;
 	if (j->log.p)
@@ -1394,6 +1399,10 @@ static int finish(struct pjob *j, const struct pov_pool_opts *opts, double t0,
 		      (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
 	res->exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 	res->term_signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
+	if (j->early && res->term_signal == SIGKILL) {
+		res->exit_status = 0;	/* our kill, after a whole output */
+		res->term_signal = 0;
+	}
 	pov_stats_parse(j->log.p, &res->stats);
 	free(res->log);
 	res->log = j->log.p ? strdup(j->log.p) : NULL;
@@ -1447,9 +1456,52 @@ struct pool {
 	int stopping;		/* a signal arrived: start nothing, stop all */
 	int devnull;
 	double t0;
-	struct pollfd *pfd;	/* scratch for poll(), one per slot */
+	int ino;		/* inotify descriptor when opts->ready, or -1 */
+	struct pollfd *pfd;	/* scratch for poll(), one per slot and ino */
 	size_t *pidx;		/* the job of each pfd */
 };
+
+/* The last path component of p. */
+static const char *base_name(const char *p)
+{
+	const char *b = strrchr(p, '/');
+
+	return b ? b + 1 : p;
+}
+
+/* Read the inotify events: a running job whose output was closed after
+ * writing, and that opts->ready accepts, is done; kill it. */
+static void pool_notice(struct pool *p)
+{
+	_Alignas(struct inotify_event) char buf[4096];
+
+	for (;;) {
+		ssize_t n = read(p->ino, buf, sizeof(buf));
+
+		if (n < 0 && errno == EINTR)
+			continue;
+		if (n <= 0)
+			return;
+		for (char *q = buf; q < buf + n;) {
+			const struct inotify_event *ev = (const struct inotify_event *)q;
+
+			q += sizeof(*ev) + ev->len;
+			if (!(ev->mask & IN_CLOSE_WRITE) || !ev->len)
+				continue;
+			for (size_t i = 0; i < p->n; i++) {
+				struct pjob *j = &p->pj[i];
+
+				if (j->state != J_RUNNING || j->early || j->stop != STOP_NONE ||
+				    j->wd != ev->wd || strcmp(base_name(j->cmd.povout), ev->name))
+					continue;
+				if (p->opts->ready(p->opts->arg, i, j->cmd.povout)) {
+					j->early = 1;
+					kill(-j->pid, SIGKILL);
+				}
+			}
+		}
+	}
+}
 
 static void job_final(struct pool *p, size_t i)
 {
@@ -1509,12 +1561,22 @@ static void pool_wait(struct pool *p)
 		wait_s = 0.005;	/* its output is closed: the exit is imminent */
 	if (wait_s < 0)
 		wait_s = 0;
+	size_t nj = npfd;
+	if (p->ino >= 0) {
+		p->pfd[npfd].fd = p->ino;
+		p->pfd[npfd].events = POLLIN;
+		p->pfd[npfd].revents = 0;
+		npfd++;
+	}
 	/* A caught signal interrupts poll() (no SA_RESTART) when it lands in
 	 * this thread; otherwise the tick bounds the delay. */
-	if (poll(p->pfd, (nfds_t)npfd, (int)ceil(wait_s * 1000.0)) > 0)
-		for (size_t k = 0; k < npfd; k++)
+	if (poll(p->pfd, (nfds_t)npfd, (int)ceil(wait_s * 1000.0)) > 0) {
+		for (size_t k = 0; k < nj; k++)
 			if (p->pfd[k].revents)
 				drain(&p->pj[p->pidx[k]]);
+		if (npfd > nj && p->pfd[nj].revents)
+			pool_notice(p);
+	}
 }
 
 /* Reap the children that exited; enforce timeouts and kill deadlines. */
@@ -1554,7 +1616,7 @@ static void pool_check(struct pool *p)
 int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool_opts *opts,
 		 struct pov_result *results, char *err, size_t errlen)
 {
-	struct pool p = { .opts = opts, .res = results, .n = njobs, .devnull = -1 };
+	struct pool p = { .opts = opts, .res = results, .n = njobs, .devnull = -1, .ino = -1 };
 	struct sigaction chld_old, chld_dfl;
 	char bin[PATH_MAX];
 	int chld_changed = 0, rc = -1, caught = 0;
@@ -1569,8 +1631,8 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 	if (njobs)
 		slots = (size_t)opts->max_jobs < njobs ? (size_t)opts->max_jobs : njobs;
 	p.pj = calloc(njobs ? njobs : 1, sizeof(*p.pj));
-	p.pfd = calloc(slots, sizeof(*p.pfd));
-	p.pidx = calloc(slots, sizeof(*p.pidx));
+	p.pfd = calloc(slots + 1, sizeof(*p.pfd));
+	p.pidx = calloc(slots + 1, sizeof(*p.pidx));
 	if (!p.pj || !p.pfd || !p.pidx) {
 		errbuf_printf(err, errlen, "out of memory");
 		goto out;
@@ -1585,6 +1647,27 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 		if (!p.pj[i].bin) {
 			errbuf_printf(err, errlen, "out of memory");
 			goto out;
+		}
+	}
+	/* Outputs seen whole before POV-Ray exits (where inotify works). */
+	if (opts->ready && njobs) {
+		p.ino = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
+		for (size_t i = 0; i < njobs && p.ino >= 0; i++) {
+			char *dir = strdup(p.pj[i].cmd.povout);
+
+			if (!dir) {
+				errbuf_printf(err, errlen, "out of memory");
+				goto out;
+			}
+			char *slash = strrchr(dir, '/');
+			if (slash)
+				*(slash == dir ? slash + 1 : slash) = '\0';
+			p.pj[i].wd = inotify_add_watch(p.ino, slash ? dir : ".", IN_CLOSE_WRITE);
+			free(dir);
+			if (p.pj[i].wd < 0) {	/* then none: every job ends at its exit */
+				close(p.ino);
+				p.ino = -1;
+			}
 		}
 	}
 	p.devnull = open("/dev/null", O_RDWR | O_CLOEXEC);
@@ -1641,6 +1724,8 @@ out:
 		pov_signals_restore();
 	if (p.devnull >= 0)
 		close(p.devnull);
+	if (p.ino >= 0)
+		close(p.ino);
 	if (p.pj) {
 		for (size_t i = 0; i < njobs; i++) {
 			cmd_release(&p.pj[i].cmd);

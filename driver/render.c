@@ -154,6 +154,7 @@ struct run {
 	double t0;
 	double prev_wall;	/* wall seconds of the passes before a resume */
 	double cost_job, cost_sample, latency;
+	double tail;		/* the base pass's wait on POV-Ray's exit */
 	int radiosity;
 	int rad_scale;		/* the scale the radiosity solution was computed at */
 	struct pass_rec *passes;
@@ -336,6 +337,33 @@ static void on_done(void *arg, size_t index, const struct pov_result *res)
 			 r->pool_total, elapsed(r));
 }
 
+/* A region render's output is whole once its last row reads (POV-Ray
+ * writes the rows in order and the line offsets last): the pool need not
+ * wait for POV-Ray to exit. */
+static int region_ready(void *arg, size_t index, const char *path)
+{
+	(void)arg;
+	(void)index;
+	char err[256];
+	int w, h, oy;
+	struct image img = {0};
+	if (image_exr_size(path, &w, &h, err, sizeof err) ||
+	    image_read_exr_rows(path, h - 1, h - 1, &img, &oy, err, sizeof err))
+		return 0;
+	image_release(&img);
+	return 1;
+}
+
+/* For a whole-frame render, whose statistics the run needs: note when
+ * its output was written, and wait for the exit. */
+static int note_written(void *arg, size_t index, const char *path)
+{
+	(void)index;
+	(void)path;
+	*(double *)arg = now_s();
+	return 0;
+}
+
 /* The analysis the planner and the final image use. */
 static int analyse(struct run *r, struct lpr_result *res, char *err, size_t errlen)
 {
@@ -499,7 +527,13 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
 	pov_pool_opts_init(&po);
 	po.max_jobs = 1;
 	po.timeout_s = r->timeout > 0 ? r->timeout : 0.0;
+	double written = 0.0;
+	po.ready = note_written;
+	po.arg = &written;
 	int rc = pov_pool_run(&job, 1, &po, res, err, errlen);
+	/* how long POV-Ray took to exit after writing its image: region
+	 * renders do not wait for that */
+	r->tail = written > 0.0 ? now_s() - written : 0.0;
 	free(extra);
 	if (rc == POV_INTERRUPTED) {
 		errbuf_printf(err, errlen, "interrupted during the %s", what);
@@ -639,6 +673,9 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	r->latency = res.wall_s - ((st->have & POV_HAVE_TRACE) ? st->trace.wall_s : 0.0) -
 		     ((st->have & POV_HAVE_PARSE) ? st->parse.wall_s : 0.0) -
 		     ((st->have & POV_HAVE_RADIOSITY) ? st->radiosity.wall_s : 0.0);
+	/* a region render's: the pool takes its image without waiting for
+	 * POV-Ray's exit (region_ready()) */
+	r->latency -= r->tail;
 	if (r->latency < 0.0)
 		r->latency = 0.0;
 	r->radiosity = (st->have & POV_HAVE_RADIOSITY) != 0;
@@ -819,6 +856,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		po.timeout_s = 60.0 + 10.0 * worst;
 	}
 	po.on_done = on_done;
+	po.ready = region_ready;
 	po.arg = r;
 	r->pool_done = 0;
 	r->pool_total = (int)n;
@@ -865,6 +903,16 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		if (!r->keep)
 			unlink(outs[k]);
 	}
+	/* what a region render waits on besides its CPU, for the budget's
+	 * next passes: less than the base pass's latency, since the pool does
+	 * not wait for POV-Ray to exit (region_ready()) */
+	double lat = INFINITY;
+	for (size_t k = 0; k < n; k++)
+		if (results[k].status == POV_OK && results[k].attempts == 1 &&
+		    results[k].wall_s - results[k].cpu_s < lat)
+			lat = results[k].wall_s - results[k].cpu_s;
+	if (lat < INFINITY)
+		r->latency = lat > 0.0 ? lat : 0.0;
 	p.wall_s = now_s() - t;
 	p.driver_cpu_s = self_cpu() - c;
 	p.est_relmse = NAN;

@@ -215,6 +215,7 @@ static void slow_job(struct pov_job *job, const char *scene, const char *out)
  *   fixture  copy $FAKE_FIXTURE to stderr and exit 1
  *   segv     kill itself with SIGSEGV
  *   noout    exit 0 without writing anything
+ *   linger   write the output, then sleep 1 s before exiting 0
  */
 static const char fake_script[] =
 	"#!/bin/sh\n"
@@ -229,6 +230,7 @@ static const char fake_script[] =
 	"fixture) cat \"$FAKE_FIXTURE\" >&2; exit 1;;\n"
 	"segv) kill -SEGV $$;;\n"
 	"noout) exit 0;;\n"
+	"linger) echo whole > \"$out\"; sleep 1; exit 0;;\n"
 	"*) exit 3;;\n"
 	"esac\n";
 
@@ -924,6 +926,77 @@ static void test_pool_limit(void **state)
 	release_all(res, N);
 }
 
+/* The ready callback: counts its calls, checks the file, says accept. */
+struct ready_log {
+	int calls, accept;
+	char path[PATH_MAX];
+};
+
+static int ready_cb(void *arg, size_t index, const char *path)
+{
+	struct ready_log *l = arg;
+	char buf[16] = { 0 };
+	FILE *f = fopen(path, "r");
+
+	(void)index;
+	l->calls++;
+	snprintf(l->path, sizeof(l->path), "%s", path);
+	assert_non_null(f);
+	assert_non_null(fgets(buf, sizeof(buf), f));
+	fclose(f);
+	assert_string_equal(buf, "whole\n");
+	return l->accept;
+}
+
+/* A job whose output is whole is done without waiting for the exit when
+ * the callback accepts it; when it does not, the pool waits. */
+static void test_pool_ready(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512];
+	struct pov_job job = { 0 };
+	struct pov_result res;
+	struct pov_pool_opts o;
+	struct ready_log l = { 0 };
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "ready"), "s.pov");
+	setenv("FAKE_MODE", "linger", 1);
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "ready/o.exr");
+	job.width = 8;
+	job.height = 8;
+	job.povray = fake_bin;
+	pov_pool_opts_init(&o);
+	o.ready = ready_cb;
+	o.arg = &l;
+	l.accept = 1;
+	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
+	assert_int_equal(res.status, POV_OK);
+	assert_int_equal(res.exit_status, 0);
+	assert_int_equal(res.term_signal, 0);
+	assert_int_equal(l.calls, 1);
+	assert_true(res.wall_s < 0.9);
+	assert_true(exists(out));
+	pov_result_release(&res);
+
+	l.calls = 0;
+	l.accept = 0;
+	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
+	assert_int_equal(res.status, POV_OK);
+	assert_int_equal(l.calls, 1);
+	assert_true(res.wall_s >= 1.0);
+	assert_true(exists(out));
+	pov_result_release(&res);
+
+	/* no output, no call */
+	l.calls = 0;
+	setenv("FAKE_MODE", "noout", 1);
+	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
+	assert_int_equal(res.status, POV_FAILED);
+	assert_int_equal(l.calls, 0);
+	pov_result_release(&res);
+}
+
 static void test_pool_crash_retry_and_no_output(void **state)
 {
 	char scene[PATH_MAX], out[PATH_MAX];
@@ -1339,6 +1412,7 @@ int main(void)
 		cmocka_unit_test(test_pool_size),
 		cmocka_unit_test(test_missing_binary),
 		cmocka_unit_test(test_pool_limit),
+		cmocka_unit_test(test_pool_ready),
 		cmocka_unit_test(test_pool_crash_retry_and_no_output),
 		cmocka_unit_test(test_pool_error_messages),
 		cmocka_unit_test(test_render_awkward_paths),
