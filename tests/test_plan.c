@@ -810,10 +810,12 @@ static enum plan_outcome plan_of(struct plan_input *in, const struct plan_params
 	return pl->outcome;
 }
 
+/* A block of 6 x 5 pixels with error, for the planner's tests. */
+static const int block[1][4] = { { 20, 17, 25, 21 } };
+
 /* 6. plan_make: refine, target met, no budget, packing, no gain. */
 static void test_plan_make(void **state)
 {
-	static const int block[1][4] = { { 20, 17, 25, 21 } };	/* 6 x 5 */
 	static const int two[2][4] = { { 2, 2, 4, 4 }, { 58, 40, 61, 43 } };
 	struct plan_input *in = malloc(sizeof(*in));
 	struct plan_params p;
@@ -930,7 +932,6 @@ static double plan_cost(const struct plan *pl, const struct plan_params *p)
  * region is split for the cores. */
 static void test_plan_budget(void **state)
 {
-	static const int block[1][4] = { { 20, 17, 25, 21 } };	/* 6 x 5 */
 	static const int all[1][4] = { { 0, 0, PW - 1, PH - 1 } };
 	struct plan_input *in = malloc(sizeof(*in));
 	struct plan_params p;
