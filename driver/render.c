@@ -579,7 +579,9 @@ static int radiosity_scale(const struct run *r)
  */
 static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, size_t errlen)
 {
-	double predicted = r->latency + r->cost_sample * k * k * (double)r->w * r->h;
+	/* a whole-frame render waits for POV-Ray's exit: the latency and the
+	 * tail the region renders do not wait on */
+	double predicted = r->latency + r->tail + r->cost_sample * k * k * (double)r->w * r->h;
 	if (r->budget > 0.0 && elapsed(r) + predicted > r->budget) {
 		if (r->verbose)
 			fprintf(stderr, "povpress render: no radiosity pass: it would take about "
