@@ -899,6 +899,17 @@ int pov_stats_parse(const char *text, struct pov_stats *st)
 	return (st->have & POV_HAVE_PIXELS) && (st->have & POV_HAVE_TRACE) ? 0 : -1;
 }
 
+int pov_render_time_printed(const char *text)
+{
+	const char *rt = strstr(text, "Render Time:");
+	const char *tt = rt ? strstr(rt, "Trace Time:") : NULL;
+	const char *cpu = tt ? strstr(tt, "CPU-seconds total") : NULL;
+	const char *rad = rt ? strstr(rt, "Radiosity Time:") : NULL;
+	const char *none = rad ? strstr(rad, "No radiosity") : NULL;
+
+	return cpu && strchr(cpu, '\n') && rad && rad < tt && none && none < tt;
+}
+
 /* ---- POV-Ray's error messages --------------------------------------- */
 
 /* Split text into lines, joining the continuations of POV-Ray's 80-column
@@ -1187,6 +1198,7 @@ struct pjob {
 	double start, deadline, kill_at;
 	int stop;		/* STOP_*: why the pool is stopping it */
 	int killed;		/* SIGKILL sent */
+	int accepted;		/* ready() accepted its output */
 	int early;		/* its output was whole before it exited: the
 				 * pool killed it */
 	int wd;			/* inotify watch of its output's directory */
@@ -1323,6 +1335,7 @@ static int spawn(struct pjob *j, int devnull, double t0, struct pov_result *res)
 	j->stop = STOP_NONE;
 	j->killed = 0;
 	j->early = 0;
+	j->accepted = 0;
 	j->kill_at = 0;
 	j->log.len = 0;
 	if (j->log.p)
@@ -1470,7 +1483,7 @@ static const char *base_name(const char *p)
 }
 
 /* Read the inotify events: a running job whose output was closed after
- * writing, and that opts->ready accepts, is done; kill it. */
+ * writing, and that opts->ready accepts, is marked accepted. */
 static void pool_notice(struct pool *p)
 {
 	_Alignas(struct inotify_event) char buf[4096];
@@ -1491,14 +1504,28 @@ static void pool_notice(struct pool *p)
 			for (size_t i = 0; i < p->n; i++) {
 				struct pjob *j = &p->pj[i];
 
-				if (j->state != J_RUNNING || j->early || j->stop != STOP_NONE ||
+				if (j->state != J_RUNNING || j->accepted || j->stop != STOP_NONE ||
 				    j->wd != ev->wd || strcmp(base_name(j->cmd.povout), ev->name))
 					continue;
-				if (p->opts->ready(p->opts->arg, i, j->cmd.povout)) {
-					j->early = 1;
-					kill(-j->pid, SIGKILL);
-				}
+				j->accepted = p->opts->ready(p->opts->arg, i, j->cmd.povout) != 0;
 			}
+		}
+	}
+}
+
+/* Kill the jobs whose output was accepted and whose console output, if
+ * opts->ready_log asks, says they are done. */
+static void pool_early(struct pool *p)
+{
+	for (size_t i = 0; i < p->n; i++) {
+		struct pjob *j = &p->pj[i];
+
+		if (j->state != J_RUNNING || !j->accepted || j->early || j->stop != STOP_NONE)
+			continue;
+		if (!p->opts->ready_log ||
+		    p->opts->ready_log(p->opts->arg, i, j->log.p ? j->log.p : "")) {
+			j->early = 1;
+			kill(-j->pid, SIGKILL);
 		}
 	}
 }
@@ -1577,6 +1604,8 @@ static void pool_wait(struct pool *p)
 		if (npfd > nj && p->pfd[nj].revents)
 			pool_notice(p);
 	}
+	if (p->ino >= 0)
+		pool_early(p);
 }
 
 /* Reap the children that exited; enforce timeouts and kill deadlines. */

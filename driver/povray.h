@@ -146,6 +146,15 @@ struct pov_stats {
 int pov_stats_parse(const char *text, struct pov_stats *st);
 
 /*
+ * Whether POV-Ray's console output text has come as far as its render
+ * time, through the trace time's CPU line, for a render without
+ * radiosity: POV-Ray prints it just after writing the image, and with
+ * radiosity it writes its radiosity file after that.  For
+ * pov_pool_opts.ready_log.
+ */
+int pov_render_time_printed(const char *text);
+
+/*
  * Build the argument vector for job: argv[0] is the binary as named (not
  * looked up), the vector is NULL-terminated and *argc_out (may be NULL)
  * counts its elements.  May create links in job->workdir (see above).  When
@@ -245,6 +254,11 @@ struct pov_pool_opts {
 	 * (its frontend polls the backend at 50 ms intervals); the pool kills
 	 * it.  Where inotify is not available, jobs end at their exit. */
 	int (*ready)(void *arg, size_t index, const char *path);
+	/* Called, if set, after ready() accepted a job's output, with its
+	 * console output so far, until it returns nonzero: only then is the
+	 * job done and POV-Ray killed (for a render whose statistics, printed
+	 * just after the image, or other files are wanted too). */
+	int (*ready_log)(void *arg, size_t index, const char *log);
 };
 
 /* Defaults: max_jobs from pov_pool_size() for one job per core, no

@@ -354,14 +354,23 @@ static int region_ready(void *arg, size_t index, const char *path)
 	return 1;
 }
 
-/* For a whole-frame render, whose statistics the run needs: note when
- * its output was written, and wait for the exit. */
+/* For a whole-frame render: note when its output was written (whole). */
 static int note_written(void *arg, size_t index, const char *path)
 {
-	(void)index;
-	(void)path;
+	if (!region_ready(NULL, index, path))
+		return 0;
 	*(double *)arg = now_s();
-	return 0;
+	return 1;
+}
+
+/* ... and end it once POV-Ray has printed its render time: the statistics
+ * the run needs come just after the image (not with radiosity, whose file
+ * comes later: such a render ends at its exit). */
+static int stats_printed(void *arg, size_t index, const char *log)
+{
+	(void)arg;
+	(void)index;
+	return pov_render_time_printed(log);
 }
 
 /* The analysis the planner and the final image use. */
@@ -529,6 +538,7 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
 	po.timeout_s = r->timeout > 0 ? r->timeout : 0.0;
 	double written = 0.0;
 	po.ready = note_written;
+	po.ready_log = stats_printed;
 	po.arg = &written;
 	int rc = pov_pool_run(&job, 1, &po, res, err, errlen);
 	/* how long POV-Ray took to exit after writing its image: region

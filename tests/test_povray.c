@@ -215,7 +215,7 @@ static void slow_job(struct pov_job *job, const char *scene, const char *out)
  *   fixture  copy $FAKE_FIXTURE to stderr and exit 1
  *   segv     kill itself with SIGSEGV
  *   noout    exit 0 without writing anything
- *   linger   write the output, then sleep 1 s before exiting 0
+ *   linger   write the output and a line, then sleep 1 s before exiting 0
  */
 static const char fake_script[] =
 	"#!/bin/sh\n"
@@ -230,7 +230,7 @@ static const char fake_script[] =
 	"fixture) cat \"$FAKE_FIXTURE\" >&2; exit 1;;\n"
 	"segv) kill -SEGV $$;;\n"
 	"noout) exit 0;;\n"
-	"linger) echo whole > \"$out\"; sleep 1; exit 0;;\n"
+	"linger) echo whole > \"$out\"; echo 'Render Time: done' >&2; sleep 1; exit 0;;\n"
 	"*) exit 3;;\n"
 	"esac\n";
 
@@ -669,6 +669,37 @@ static void parse_fixture(const char *name, struct pov_stats *st, int want_rc)
 	free(text);
 }
 
+/* The render time printed, through the trace's CPU line, without radiosity. */
+static void test_render_time_printed(void **state)
+{
+	char path[256];
+	char *text, *cut;
+
+	(void)state;
+	snprintf(path, sizeof(path), DATA "noaa.txt");
+	text = read_file(path);
+	assert_non_null(text);
+	assert_true(pov_render_time_printed(text));
+	/* up to the trace time's CPU line, without its end: not yet */
+	cut = strstr(strstr(text, "Trace Time:"), "CPU-seconds total");
+	assert_non_null(cut);
+	cut[strlen("CPU-seconds total")] = '\0';
+	assert_false(pov_render_time_printed(text));
+	*strstr(text, "Render Time:") = '\0';
+	assert_false(pov_render_time_printed(text));
+	free(text);
+	snprintf(path, sizeof(path), DATA "radiosity.txt");
+	text = read_file(path);
+	assert_non_null(text);
+	assert_false(pov_render_time_printed(text));
+	free(text);
+	snprintf(path, sizeof(path), DATA "photons.txt");
+	text = read_file(path);
+	assert_non_null(text);
+	assert_true(pov_render_time_printed(text));
+	free(text);
+}
+
 static void test_stats_no_aa(void **state)
 {
 	struct pov_stats st;
@@ -948,6 +979,20 @@ static int ready_cb(void *arg, size_t index, const char *path)
 	return l->accept;
 }
 
+static int log_says_done(void *arg, size_t index, const char *log)
+{
+	(void)arg;
+	(void)index;
+	return strstr(log, "Render Time: done") != NULL;
+}
+
+static int log_says_never(void *arg, size_t index, const char *log)
+{
+	(void)arg;
+	(void)index;
+	return strstr(log, "something POV-Ray never prints") != NULL;
+}
+
 /* A job whose output is whole is done without waiting for the exit when
  * the callback accepts it; when it does not, the pool waits. */
 static void test_pool_ready(void **state)
@@ -987,6 +1032,24 @@ static void test_pool_ready(void **state)
 	assert_true(res.wall_s >= 1.0);
 	assert_true(exists(out));
 	pov_result_release(&res);
+
+	/* accepted, and done when the console says so: at once when it says
+	 * what ready_log wants, at the exit when it never does */
+	l.calls = 0;
+	l.accept = 1;
+	o.ready_log = log_says_done;
+	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
+	assert_int_equal(res.status, POV_OK);
+	assert_int_equal(res.exit_status, 0);
+	assert_true(res.wall_s < 0.9);
+	pov_result_release(&res);
+	o.ready_log = log_says_never;
+	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
+	assert_int_equal(res.status, POV_OK);
+	assert_int_equal(l.calls, 2);
+	assert_true(res.wall_s >= 1.0);
+	pov_result_release(&res);
+	o.ready_log = NULL;
 
 	/* no output, no call */
 	l.calls = 0;
@@ -1404,6 +1467,7 @@ int main(void)
 		cmocka_unit_test(test_shell_line_words),
 		cmocka_unit_test(test_shell_line_round_trip_args),
 		cmocka_unit_test(test_shell_line_renders),
+		cmocka_unit_test(test_render_time_printed),
 		cmocka_unit_test(test_stats_no_aa),
 		cmocka_unit_test(test_stats_aa),
 		cmocka_unit_test(test_stats_verbose_region),
