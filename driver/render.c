@@ -63,7 +63,7 @@ static const char usage_options[] =
 	"  --budget SECONDS      wall-clock seconds to stop within (default: none)\n"
 	"  --max-passes N        refinement passes after the base pass (default 8)\n"
 	"  --jobs N              POV-Ray processes at once (default 4 per core: each\n"
-	"                        invocation waits ~0.65 s on POV-Ray itself)\n"
+	"                        invocation waits 0.3 to 0.7 s on POV-Ray itself)\n"
 	"  --timeout SECONDS     per POV-Ray run; one retry after a crash or timeout\n"
 	"                        (default: 60 + 10 x the dearest region's predicted cost)\n"
 	"  --cost-job S          the planner's cost of one POV-Ray run, seconds, and\n"
