@@ -813,18 +813,27 @@ static enum plan_outcome plan_of(struct plan_input *in, const struct plan_params
 /* A block of 6 x 5 pixels with error, for the planner's tests. */
 static const int block[1][4] = { { 20, 17, 25, 21 } };
 
+/* A planner test's input (the block, error 0.25; free() it) and default
+ * parameters. */
+static struct plan_input *plan_setup(struct plan_params *p)
+{
+	struct plan_input *in = malloc(sizeof(*in));
+
+	assert_non_null(in);
+	plan_params_init(p);
+	plan_input(in, block, 1, 0.25f);
+	return in;
+}
+
 /* 6. plan_make: refine, target met, no budget, packing, no gain. */
 static void test_plan_make(void **state)
 {
 	static const int two[2][4] = { { 2, 2, 4, 4 }, { 58, 40, 61, 43 } };
-	struct plan_input *in = malloc(sizeof(*in));
 	struct plan_params p;
+	struct plan_input *in = plan_setup(&p);
 	struct plan pl;
 
 	(void)state;
-	assert_non_null(in);
-	plan_params_init(&p);
-	plan_input(in, block, 1, 0.25f);
 	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
 	assert_int_equal(pl.chosen_pixels, 30);
 	for (int y = 0; y < PH; y++)
@@ -933,16 +942,13 @@ static double plan_cost(const struct plan *pl, const struct plan_params *p)
 static void test_plan_budget(void **state)
 {
 	static const int all[1][4] = { { 0, 0, PW - 1, PH - 1 } };
-	struct plan_input *in = malloc(sizeof(*in));
 	struct plan_params p;
+	struct plan_input *in = plan_setup(&p);
 	struct plan pl;
 
 	(void)state;
-	assert_non_null(in);
-	plan_params_init(&p);
 	p.target = 1e-6;
 	p.budget = 0.2;
-	plan_input(in, block, 1, 0.25f);
 	/* without fill: scale 2, the next */
 	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
 	double est = pl.est_relmse, after2 = pl.est_after;
