@@ -116,6 +116,7 @@ int plan_pixel_errors(const struct image *acc, const float *press, const float *
 
 struct cand {
 	size_t i;
+	int s;			/* the scale it is refined at next */
 	double gain, score;
 };
 
@@ -321,30 +322,21 @@ int plan_grid_scale(const struct plan_params *p, int w, int h, int s)
 			  (p->grid == PLAN_GRID_LARGE && (double)s * s * w * h > PLAN_GRID_FRAME));
 }
 
-int plan_next_scale(const struct plan_params *p, const struct image *acc, size_t i)
+/* The first scale past cur that pixel i may be refined at: unused, and
+ * not 2 under PLAN_GRID_ONLY; 0 if none. */
+static int scale_after(const struct plan_params *p, const struct image *acc, size_t i, int cur)
 {
-	if (p->grid != PLAN_GRID_ONLY)
-		return accum_next_scale(acc, i);
 	for (int k = 0; k < ACC_NSCALES; k++) {
 		int s = accum_scales[k];
-		if (s != 2 && !accum_has_scale(acc, i, s))
+		if (s > cur && !(s == 2 && p->grid == PLAN_GRID_ONLY) && !accum_has_scale(acc, i, s))
 			return s;
 	}
 	return 0;
 }
 
-/* The first scale past cur that pixel i may be refined at in a pass:
- * unused, at most smax, and not 2 under PLAN_GRID_ONLY; 0 if none. */
-static int scale_after(const struct plan_params *p, const struct image *acc, size_t i, int cur,
-		       int smax)
+int plan_next_scale(const struct plan_params *p, const struct image *acc, size_t i)
 {
-	for (int k = 0; k < ACC_NSCALES; k++) {
-		int s = accum_scales[k];
-		if (s <= cur || (s == 2 && p->grid == PLAN_GRID_ONLY) || accum_has_scale(acc, i, s))
-			continue;
-		return s <= smax ? s : 0;
-	}
-	return 0;
+	return scale_after(p, acc, i, 0);
 }
 
 /* Taking a pixel from scale `from` on to `to` in this pass: what it gains
@@ -397,8 +389,8 @@ static struct upgrade heap_pop(struct upgrade *h, size_t *n)
 static int next_upgrade(const struct plan_params *p, const struct image *acc, size_t i, double e,
 			int cur, int smax, struct upgrade *u)
 {
-	int to = scale_after(p, acc, i, cur, smax);
-	if (!to)
+	int to = scale_after(p, acc, i, cur);
+	if (!to || to > smax)
 		return 0;
 	double n = acc->px[i * ACC_NCH + ACC_SAMPLES];
 	double m1 = (double)cur * cur, m2 = (double)to * to;
@@ -410,20 +402,22 @@ static int next_upgrade(const struct plan_params *p, const struct image *acc, si
 	return 1;
 }
 
-/* Pixels of region r that its scale was planned for (ps), and their gain. */
-static void region_count(const struct plan_region *r, int w, const unsigned char *ps,
-			 const double *gain, struct plan_region *o)
+/* Count region r's pixels that its scale was planned for (ps) into its
+ * chosen and gain, and set its cost. */
+static void region_count(const struct plan_params *p, struct plan_region *r, int w,
+			 const unsigned char *ps, const double *gain)
 {
-	o->chosen = 0;
-	o->gain = 0.0;
+	r->chosen = 0;
+	r->gain = 0.0;
 	for (int y = r->y0; y <= r->y1; y++)
 		for (int x = r->x0; x <= r->x1; x++) {
 			size_t i = (size_t)y * w + x;
 			if (ps[i] == r->scale) {
-				o->chosen++;
-				o->gain += gain[i];
+				r->chosen++;
+				r->gain += gain[i];
 			}
 		}
+	r->cost = rect_cost(p, r);
 }
 
 /*
@@ -458,10 +452,8 @@ static int split_regions(const struct plan_params *p, struct plan *out, const un
 			a.x1 = a.x0 + rw / 2 - 1;
 			b.x0 = a.x1 + 1;
 		}
-		region_count(&a, out->w, ps, gain, &a);
-		region_count(&b, out->w, ps, gain, &b);
-		a.cost = rect_cost(p, &a);
-		b.cost = rect_cost(p, &b);
+		region_count(p, &a, out->w, ps, gain);
+		region_count(p, &b, out->w, ps, gain);
 		void *q = realloc(out->regions, (out->nregions + 1) * sizeof(*out->regions));
 		if (!q)
 			return -1;
@@ -527,8 +519,7 @@ static int fit_budget(const struct plan_params *p, struct plan *out, const unsig
 			d->r = *r;
 			d->r.y0 = y;
 			d->r.y1 = y + p->tile - 1 < r->y1 ? y + p->tile - 1 : r->y1;
-			region_count(&d->r, out->w, ps, gain, &d->r);
-			d->r.cost = rect_cost(p, &d->r);
+			region_count(p, &d->r, out->w, ps, gain);
 			d->parent = k;
 			d->seq = (size_t)q;
 			d->keep = 0;
@@ -564,6 +555,30 @@ static int fit_budget(const struct plan_params *p, struct plan *out, const unsig
 	}
 	out->nregions = n;
 	free(b);
+	return 0;
+}
+
+/* Pack the chosen pixels (the first taken of cand) per scale, ps their
+ * planned scales, into out's regions.  Returns 0, -1 when out of memory. */
+static int pack_all(const struct plan_params *p, int w, int h, const struct cand *cand,
+		    size_t taken, const unsigned char *ps, const double *gain, unsigned char *mark,
+		    struct plan *out)
+{
+	for (int k = 0; k < ACC_NSCALES; k++) {
+		int s = accum_scales[k], any = 0;
+		memset(mark, 0, (size_t)w * h);
+		for (size_t t = 0; t < taken; t++)
+			if (ps[cand[t].i] == s)
+				any = mark[cand[t].i] = 1;
+		if (!any)
+			continue;
+		int rc, tile = p->tile;
+		while ((rc = pack(p, w, h, s, mark, gain, tile, p->max_regions, &out->regions,
+				  &out->nregions)) == 1)
+			tile *= 2;
+		if (rc)
+			return -1;
+	}
 	return 0;
 }
 
@@ -664,108 +679,82 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 		if (g < p->min_gain * p->target)
 			continue;
 		cand[nc].i = i;
+		cand[nc].s = s;
 		cand[nc].gain = g;
 		cand[nc].score = g / m;
 		nc++;
 	}
 	qsort(cand, nc, sizeof(*cand), by_score);
 
-	/*
-	 * Take pixels at their next scales until the predicted error meets
-	 * target * margin or the samples alone would exceed the budget.  Then,
-	 * in a pass that may be the last (p->fill), with the goal unmet and
-	 * the share of the budget unspent, take the chosen pixels on to later
-	 * scales, the best gain per cost first.  The rectangles cost more than
-	 * the pixels (they cover their neighbours too): while they would cost
-	 * more than the budget, or than the share allows, the choice is made
-	 * again with less to spend.
-	 */
+	/* take pixels at their next scales until the predicted error meets
+	 * target * margin or the samples alone would exceed the budget */
 	const double goal = p->target * p->margin * (double)npx;
+	const double cap = p->budget > 0.0 ? p->budget : INFINITY;
+	double total0 = out->est_relmse * (double)npx, spend0 = 0.0;
+	size_t taken = 0;
+	for (; taken < nc && total0 > goal; taken++) {
+		const struct cand *c = &cand[taken];
+		double cs = p->cost_sample * c->s * c->s;
+		if (spend0 + cs > cap)
+			break;
+		spend0 += cs;
+		total0 -= c->gain;
+		gain[c->i] = c->gain;
+		ps[c->i] = (unsigned char)c->s;
+	}
+	if (!taken) {
+		out->outcome = nc ? PLAN_NO_BUDGET : PLAN_NO_GAIN;
+		ret = 0;
+		goto out;
+	}
+
+	/*
+	 * Then, in a pass that may be the last (p->fill), with the goal unmet
+	 * and the share of the budget unspent, take the chosen pixels on to
+	 * later scales, the best gain per cost first.  The rectangles cost more
+	 * than the pixels (they cover their neighbours too): while they would
+	 * cost more than the budget, or than the share allows, what the
+	 * upgrades may spend is bisected between a share that fit and one that
+	 * did not.
+	 */
 	const double limit = p->fill > 0.0 && (p->budget <= 0.0 || 1.25 * p->fill < p->budget)
 				     ? 1.25 * p->fill
 				     : p->budget;
-	const double cap = p->budget > 0.0 ? p->budget : INFINITY;
-	double upto = p->fill < cap ? p->fill : cap, lo = -1.0, hi = INFINITY;
-	size_t taken = 0;
+	double upto = p->fill < cap ? p->fill : cap, lo = spend0, hi = INFINITY;
+	const int upgrading = total0 > goal && spend0 < upto;
+	if (upgrading && !(heap = malloc(taken * sizeof(*heap)))) {
+		errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
+		goto out;
+	}
 	for (int attempt = 0;; attempt++) {
-		double total = out->est_relmse * (double)npx, spend = 0.0;
-		for (size_t t = 0; t < taken; t++) {
-			ps[cand[t].i] = 0;
-			gain[cand[t].i] = 0.0;
+		double total = total0, spend = spend0;
+		size_t nh = 0;
+		for (size_t t = 0; upgrading && t < taken; t++) {
+			struct upgrade u;
+			size_t i = cand[t].i;
+			if (next_upgrade(p, acc, i, e[i], ps[i], smax, &u))
+				heap_push(heap, &nh, u);
 		}
-		free(out->regions);
-		out->regions = NULL;
-		out->nregions = 0;
-		for (taken = 0; taken < nc && total > goal; taken++) {
-			size_t i = cand[taken].i;
-			int s = plan_next_scale(p, acc, i);
-			double c = p->cost_sample * s * s;
-			if (spend + c > cap)
-				break;
-			spend += c;
-			total -= cand[taken].gain;
-			gain[i] = cand[taken].gain;
-			ps[i] = (unsigned char)s;
-		}
-		if (!taken)
-			break;
-		const double spend0 = spend;
-		if (total > goal && spend < upto) {
-			if (!heap && !(heap = malloc(nc * sizeof(*heap)))) {
-				errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
-				goto out;
-			}
-			size_t nh = 0;
-			for (size_t t = 0; t < taken; t++) {
-				struct upgrade u;
-				size_t i = cand[t].i;
-				if (next_upgrade(p, acc, i, e[i], ps[i], smax, &u))
-					heap_push(heap, &nh, u);
-			}
-			while (nh && total > goal && spend < upto) {
-				struct upgrade u = heap_pop(heap, &nh);
-				if (spend + u.cost > upto)
-					continue;
-				spend += u.cost;
-				total -= u.gain;
-				gain[u.i] += u.gain;
-				ps[u.i] = (unsigned char)u.to;
-				if (next_upgrade(p, acc, u.i, e[u.i], u.to, smax, &u))
-					heap_push(heap, &nh, u);
-			}
-		}
-
-		/* pack per scale */
-		for (int k = 0; k < ACC_NSCALES; k++) {
-			int s = accum_scales[k], any = 0;
-			memset(mark, 0, npx);
-			for (size_t t = 0; t < taken; t++) {
-				size_t i = cand[t].i;
-				if (ps[i] == s) {
-					mark[i] = 1;
-					any = 1;
-				}
-			}
-			if (!any)
+		while (nh && total > goal && spend < upto) {
+			struct upgrade u = heap_pop(heap, &nh);
+			if (spend + u.cost > upto)
 				continue;
-			int rc, tile = p->tile;
-			while ((rc = pack(p, w, h, s, mark, gain, tile, p->max_regions,
-					  &out->regions, &out->nregions)) == 1)
-				tile *= 2;
-			if (rc) {
-				errbuf_printf(err, errlen, "out of memory packing regions");
-				goto out;
-			}
+			spend += u.cost;
+			total -= u.gain;
+			gain[u.i] += u.gain;
+			ps[u.i] = (unsigned char)u.to;
+			if (next_upgrade(p, acc, u.i, e[u.i], u.to, smax, &u))
+				heap_push(heap, &nh, u);
 		}
+		if (pack_all(p, w, h, cand, taken, ps, gain, mark, out)) {
+			errbuf_printf(err, errlen, "out of memory packing regions");
+			goto out;
+		}
+		if (spend == spend0 || attempt == 7)
+			break;
 		double c = 0.0;
 		for (size_t k = 0; k < out->nregions; k++)
 			c += out->regions[k].cost;
-		if (spend == spend0 || attempt == 7)
-			break;
-		/* again with fewer upgrades: a bisection of what they may spend
-		 * between a share that fit and one that did not */
-		if (lo < 0.0)
-			lo = spend0;
 		if (c <= limit) {
 			lo = upto;
 			if (hi == INFINITY || hi - lo < 0.1 * hi || attempt >= 6)
@@ -779,11 +768,14 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 			upto = spend0 + (spend - spend0) * 0.8 * limit / c;
 		else
 			upto = 0.5 * (lo + hi);
-	}
-	if (!taken) {
-		out->outcome = nc ? PLAN_NO_BUDGET : PLAN_NO_GAIN;
-		ret = 0;
-		goto out;
+		/* back to the pixels at their next scales */
+		for (size_t t = 0; t < taken; t++) {
+			ps[cand[t].i] = (unsigned char)cand[t].s;
+			gain[cand[t].i] = cand[t].gain;
+		}
+		free(out->regions);
+		out->regions = NULL;
+		out->nregions = 0;
 	}
 
 	/* over the budget: the least worth goes; over the cap or still over

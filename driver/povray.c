@@ -1486,6 +1486,7 @@ static const char *base_name(const char *p)
  * writing, and that opts->ready accepts, is marked accepted. */
 static void pool_notice(struct pool *p)
 {
+#ifdef __linux__
 	_Alignas(struct inotify_event) char buf[4096];
 
 	for (;;) {
@@ -1511,6 +1512,9 @@ static void pool_notice(struct pool *p)
 			}
 		}
 	}
+#else
+	(void)p;
+#endif
 }
 
 /* Kill the jobs whose output was accepted and whose console output, if
@@ -1679,6 +1683,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 		}
 	}
 	/* Outputs seen whole before POV-Ray exits (where inotify works). */
+#ifdef __linux__
 	if (opts->ready && njobs) {
 		p.ino = inotify_init1(IN_NONBLOCK | IN_CLOEXEC);
 		for (size_t i = 0; i < njobs && p.ino >= 0; i++) {
@@ -1699,6 +1704,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 			}
 		}
 	}
+#endif
 	p.devnull = open("/dev/null", O_RDWR | O_CLOEXEC);
 	if (p.devnull >= 0)
 		p.devnull = high_fd(p.devnull);

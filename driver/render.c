@@ -337,10 +337,10 @@ static void on_done(void *arg, size_t index, const struct pov_result *res)
 			 r->pool_total, elapsed(r));
 }
 
-/* A region render's output is whole once its last row reads (POV-Ray
- * writes the rows in order and the line offsets last): the pool need not
- * wait for POV-Ray to exit. */
-static int region_ready(void *arg, size_t index, const char *path)
+/* A render's output is whole once its last row reads (POV-Ray writes the
+ * rows in order and the line offsets last): for a region render the pool
+ * need not wait for POV-Ray to exit. */
+static int output_whole(void *arg, size_t index, const char *path)
 {
 	(void)arg;
 	(void)index;
@@ -357,7 +357,7 @@ static int region_ready(void *arg, size_t index, const char *path)
 /* For a whole-frame render: note when its output was written (whole). */
 static int note_written(void *arg, size_t index, const char *path)
 {
-	if (!region_ready(NULL, index, path))
+	if (!output_whole(NULL, index, path))
 		return 0;
 	*(double *)arg = now_s();
 	return 1;
@@ -686,7 +686,7 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 		     ((st->have & POV_HAVE_PARSE) ? st->parse.wall_s : 0.0) -
 		     ((st->have & POV_HAVE_RADIOSITY) ? st->radiosity.wall_s : 0.0);
 	/* a region render's: the pool takes its image without waiting for
-	 * POV-Ray's exit (region_ready()) */
+	 * POV-Ray's exit (output_whole()) */
 	r->latency -= r->tail;
 	if (r->latency < 0.0)
 		r->latency = 0.0;
@@ -868,7 +868,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		po.timeout_s = 60.0 + 10.0 * worst;
 	}
 	po.on_done = on_done;
-	po.ready = region_ready;
+	po.ready = output_whole;
 	po.arg = r;
 	r->pool_done = 0;
 	r->pool_total = (int)n;
@@ -917,7 +917,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	}
 	/* what a region render waits on besides its CPU, for the budget's
 	 * next passes: less than the base pass's latency, since the pool does
-	 * not wait for POV-Ray to exit (region_ready()) */
+	 * not wait for POV-Ray to exit (output_whole()) */
 	double lat = INFINITY;
 	for (size_t k = 0; k < n; k++)
 		if (results[k].status == POV_OK && results[k].attempts == 1 &&
