@@ -477,7 +477,7 @@ double accum_error_scale(const struct image *acc, size_t i, const float fit[3])
 	const float *o = acc->px + i * ACC_NCH;
 	double den = 0.0;
 	for (int c = 0; c < 3; c++) {
-		double f = isfinite(fit[c]) ? fit[c] : o[c];
+		double f = fit && isfinite(fit[c]) ? fit[c] : o[c];
 		den += (f * f + METRICS_RELMSE_EPS) / 3.0;
 	}
 	return den;
@@ -542,21 +542,28 @@ static double range_bound(const struct image *acc, size_t i)
 	return isfinite(b) ? b : 1.0;
 }
 
+double accum_pixel_noise(const struct image *acc, size_t i, double diff)
+{
+	const float *o = acc->px + i * ACC_NCH;
+	double n = o[ACC_SAMPLES];
+	if (!(n >= 4.0))
+		return NAN;
+	if (isfinite(diff))
+		return diff * value_bias(o);
+	/* samples from a single render (a radiosity pass): the variance of
+	 * their mean */
+	double v[3];
+	for (int c = 0; c < 3; c++)
+		v[c] = o[ACC_VAR_R + c] / n;
+	return rel3(o, v) * value_bias(o);
+}
+
 double accum_pixel_error(const struct image *acc, size_t i, double press, const float fit[3],
 			 double diff)
 {
 	const float *o = acc->px + i * ACC_NCH;
-	double n = o[ACC_SAMPLES], e;
-	if (n >= 4.0 && isfinite(diff)) {
-		e = diff * value_bias(o);
-	} else if (n >= 4.0) {
-		/* samples from a single render (a radiosity pass): the
-		 * variance of their mean */
-		double v[3];
-		for (int c = 0; c < 3; c++)
-			v[c] = o[ACC_VAR_R + c] / n;
-		e = rel3(o, v) * value_bias(o);
-	} else {
+	double n = o[ACC_SAMPLES], e = accum_pixel_noise(acc, i, diff);
+	if (!(n >= 4.0)) {
 		/* no estimate (a hole the regression could not reach): assume
 		 * the worst a pixel of this brightness can plausibly be off by */
 		e = isfinite(press) ? press / accum_error_scale(acc, i, fit) : 1.0;
@@ -578,8 +585,42 @@ double accum_pixel_error(const struct image *acc, size_t i, double press, const 
 	return e;
 }
 
-long accum_final_image(const struct image *acc, const float *fit, const float *press,
-		       const float *leverage, enum accum_final mode, float *rgb)
+/*
+ * Whether pixel i's noise is like its neighbours': the geometric mean over
+ * its 3x3 neighbours with 2 samples or more of their mean's variance over
+ * its own (mean over R, G, B) lies within a factor ACC_FIT_ALIKE.  The fit
+ * averages the neighbours; where a pixel is far noisier than they (a
+ * highlight's pixel among dark ones) or far smoother, it is not of their
+ * kind, and a fit pulled to them misses it by more than its own noise can
+ * show (hdr_highlights: a highlight's mean 1.41, the fit 0.25, the truth
+ * 1.34, the fit within two of the mean's standard deviations).
+ */
+#define ACC_FIT_ALIKE 4.0
+static int noise_alike(const struct image *acc, size_t i)
+{
+	const int w = acc->w, h = acc->h, x = (int)(i % (size_t)w), y = (int)(i / (size_t)w);
+	const float *o = acc->px + i * ACC_NCH;
+	const double vi = ((double)o[ACC_VAR_R] + o[ACC_VAR_G] + o[ACC_VAR_B]) / o[ACC_SAMPLES];
+	double sl = 0.0;
+	int k = 0;
+	for (int dy = -1; dy <= 1; dy++)
+		for (int dx = -1; dx <= 1; dx++) {
+			if ((!dx && !dy) || x + dx < 0 || x + dx >= w || y + dy < 0 || y + dy >= h)
+				continue;
+			const float *q = acc->px + ((size_t)(y + dy) * w + (x + dx)) * ACC_NCH;
+			if (!(q[ACC_SAMPLES] >= 2.0f))
+				continue;
+			double vq = ((double)q[ACC_VAR_R] + q[ACC_VAR_G] + q[ACC_VAR_B]) /
+				    q[ACC_SAMPLES];
+			sl += log((vq + 1e-30) / (vi + 1e-30));
+			k++;
+		}
+	return k > 0 && isfinite(sl) && fabs(sl / k) <= log(ACC_FIT_ALIKE);
+}
+
+long accum_final_choose(const struct image *acc, const float *fit, const float *press,
+			const float *leverage, const double *noise, enum accum_final mode,
+			unsigned char *take, double *e)
 {
 	size_t npx = (size_t)acc->w * acc->h;
 	long took = 0;
@@ -588,34 +629,43 @@ long accum_final_image(const struct image *acc, const float *fit, const float *p
 		const float *f = fit + 3 * i;
 		double n = o[ACC_SAMPLES];
 		int fin = isfinite(f[0]) && isfinite(f[1]) && isfinite(f[2]);
-		int use_fit;
+		int use_fit = 0;
 		if (n <= 0.0)
 			use_fit = 1;
 		else if (!fin || mode == ACC_FINAL_SAMPLES)
 			use_fit = 0;
 		else if (mode == ACC_FINAL_RECONSTRUCTION)
 			use_fit = 1;
-		else {
-			double h = leverage[i], e = press[i];
-			if (!isfinite(h) || !isfinite(e) || h < 0.0 || h > 1.0 || n < 4.0) {
-				use_fit = 0;
-			} else {
-				double v = e / (1.0 + h);
-				if (n >= 4.0)
-					v = (o[ACC_VAR_R] + o[ACC_VAR_G] + o[ACC_VAR_B]) / 3.0 / n;
-				double bias = e - v > 0.0 ? e - v : 0.0;
+		else if (n >= 4.0 && isfinite(o[ACC_DIFF]) && isfinite(noise[i])) {
+			double h = leverage[i], p = press[i];
+			double sc = accum_error_scale(acc, i, NULL);
+			double v = ((double)o[ACC_VAR_R] + o[ACC_VAR_G] + o[ACC_VAR_B]) / 3.0 / n;
+			double u = noise[i] * sc < v ? noise[i] * sc : v;
+			if (isfinite(h) && isfinite(p) && h >= 0.0 && h <= 1.0 && u > 0.0) {
+				double bias = p - u > 0.0 ? p - u : 0.0;
+				double pred = h * h * u + (1.0 - h) * (1.0 - h) * bias;
 				double d2 = 0.0;
 				for (int c = 0; c < 3; c++)
 					d2 += ((double)f[c] - o[c]) * ((double)f[c] - o[c]) / 3.0;
-				/* and only a fit within two standard deviations of the
-				 * samples: a fit further off has bias the smoothed PRESS
-				 * did not see (a highlight, an edge) */
-				use_fit = h * h * v + (1.0 - h) * (1.0 - h) * bias < v && d2 <= 4.0 * v;
+				use_fit = pred < ACC_FIT_GAIN * u && d2 <= 4.0 * u &&
+					  noise_alike(acc, i);
+				/* the pixel's error is then the fit's, unless an
+				 * edge between its samples was the larger part */
+				if (use_fit && e && !(e[i] > noise[i]))
+					e[i] = pred / sc;
 			}
 		}
-		for (int c = 0; c < 3; c++)
-			rgb[3 * i + c] = use_fit ? f[c] : o[c];
+		take[i] = (unsigned char)use_fit;
 		took += use_fit;
 	}
 	return took;
+}
+
+void accum_final_image(const struct image *acc, const float *fit, const unsigned char *take,
+		       float *rgb)
+{
+	size_t npx = (size_t)acc->w * acc->h;
+	for (size_t i = 0; i < npx; i++)
+		for (int c = 0; c < 3; c++)
+			rgb[3 * i + c] = take[i] ? fit[3 * i + c] : acc->px[i * ACC_NCH + c];
 }

@@ -146,8 +146,8 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 		     int y1, int pass, long *folded, char *err, size_t errlen);
 
 /* What pixel i's relative errors are relative to: the mean over R, G, B
- * of value^2 + 0.01, the value being fit (the regression's, where finite)
- * or else the samples' mean. */
+ * of value^2 + 0.01, the value being fit (the regression's, where finite;
+ * fit may be NULL) or else the samples' mean. */
 double accum_error_scale(const struct image *acc, size_t i, const float fit[3]);
 
 /*
@@ -170,6 +170,14 @@ double accum_error_scale(const struct image *acc, size_t i, const float fit[3]);
 double accum_pixel_error(const struct image *acc, size_t i, double press, const float fit[3],
 			 double diff);
 
+/*
+ * The noise part of that estimate: for a pixel of 4 samples or more,
+ * diff (as for accum_pixel_error()) or, without one, its sample variance
+ * over n, relative to value^2 + 0.01 (of an estimate of the true value);
+ * NaN for fewer samples.
+ */
+double accum_pixel_noise(const struct image *acc, size_t i, double diff);
+
 /* What the final image holds per pixel. */
 enum accum_final {
 	ACC_FINAL_AUTO,			/* the one predicted to be closer (below) */
@@ -177,17 +185,39 @@ enum accum_final {
 	ACC_FINAL_RECONSTRUCTION,	/* the regression's fit */
 };
 
+/* The fit must be predicted to miss by less than this share of the
+ * samples' error (accum_final_choose()). */
+#define ACC_FIT_GAIN 0.5
+
 /*
- * Fill rgb (w*h*3) with the final image; returns how many pixels took the
- * fit.  For ACC_FINAL_AUTO, per pixel: with v the variance of the samples'
- * mean (the sample variance over n once n >= 4, else the PRESS error over
- * 1 + H, what it is for pure noise) and H the pixel's leverage, the fit
- * H Y + (1 - H) f(-i) is expected to miss by H^2 v + (1 - H)^2 (press - v),
- * the samples by v; the fit wins when it is smaller and the fit lies
- * within two standard deviations (2 sqrt(v)) of the samples' mean.  Pixels without a finite fit keep
- * their samples, pixels without samples take the fit.
+ * Which pixels the final image takes from the regression's fit: take[i]
+ * set (w*h bytes); returns how many.  Pixels without samples take the fit,
+ * pixels without a finite fit keep their samples.  For ACC_FINAL_AUTO, a
+ * pixel takes the fit only where all of these hold:
+ * - it has 4 samples or more and a fold difference (two independent sample
+ *   sets: its noise is measured, not assumed);
+ * - with u the squared error of its samples' mean (noise[i], the relative
+ *   accum_pixel_noise(), times value^2 + 0.01; at most the sample variance
+ *   over n), H its leverage and press its PRESS error, the fit
+ *   H Y + (1 - H) f(-i) is expected to miss by H^2 u + (1 - H)^2 (press - u),
+ *   less than ACC_FIT_GAIN u;
+ * - the fit lies within two standard deviations (2 sqrt(u)) of the mean;
+ * - its noise is like its neighbours' (within a factor 4 of their
+ *   geometric mean): the fit is theirs too.
+ * The sample variance over n is no measure of a mean's error on stratified
+ * samples of deterministic detail (thin rods, a radiosity pass's grid: the
+ * mean is 10 to 100 times closer), hence the fold difference and the
+ * neighbours.  With e (the pixels' relative error estimates, may be NULL),
+ * a pixel that takes the fit gets the fit's predicted error, unless e[i]
+ * exceeded its noise (an edge between its samples).
  */
-long accum_final_image(const struct image *acc, const float *fit, const float *press,
-		       const float *leverage, enum accum_final mode, float *rgb);
+long accum_final_choose(const struct image *acc, const float *fit, const float *press,
+			const float *leverage, const double *noise, enum accum_final mode,
+			unsigned char *take, double *e);
+
+/* Fill rgb (w*h*3) with the final image: the fit where take[i], else the
+ * samples' mean. */
+void accum_final_image(const struct image *acc, const float *fit, const unsigned char *take,
+		       float *rgb);
 
 #endif

@@ -90,7 +90,7 @@ static double diff_around(const struct image *acc, const double *mv, int x, int 
 }
 
 int plan_pixel_errors(const struct image *acc, const float *press, const float *fit,
-		      double *e, double *est, char *err, size_t errlen)
+		      double *e, double *noise, double *est, char *err, size_t errlen)
 {
 	size_t n = (size_t)acc->w * acc->h;
 	double *mv = malloc((n ? n : 1) * sizeof(*mv));
@@ -107,6 +107,8 @@ int plan_pixel_errors(const struct image *acc, const float *press, const float *
 		double diff = isfinite(o[ACC_DIFF]) ?
 			diff_around(acc, mv, (int)(i % (size_t)acc->w), (int)(i / (size_t)acc->w)) : NAN;
 		e[i] = accum_pixel_error(acc, i, press[i], fit + 3 * i, diff);
+		if (noise)
+			noise[i] = accum_pixel_noise(acc, i, diff);
 		sum += e[i];
 	}
 	free(mv);
@@ -614,7 +616,7 @@ int plan_make(const struct image *acc, const float *press, const float *fit,
 		return -1;
 	}
 	double est;
-	int rc = plan_pixel_errors(acc, press, fit, e, &est, err, errlen);
+	int rc = plan_pixel_errors(acc, press, fit, e, NULL, &est, err, errlen);
 	if (rc)
 		memset(out, 0, sizeof(*out));
 	else

@@ -113,10 +113,11 @@ const char *plan_outcome_name(enum plan_outcome o);
  * Estimated relative error of every pixel (w*h doubles into e) from the
  * analysis (error and fit, as lpr_result or `povpress analyze` give them)
  * and the accumulation, and in *est the image relMSE estimate (their
- * mean).  Returns 0, or -1 out of memory (err says so).
+ * mean); with noise (may be NULL), w*h doubles, each pixel's noise part
+ * (accum_pixel_noise()).  Returns 0, or -1 out of memory (err says so).
  */
 int plan_pixel_errors(const struct image *acc, const float *press, const float *fit,
-		      double *e, double *est, char *err, size_t errlen);
+		      double *e, double *noise, double *est, char *err, size_t errlen);
 
 /* Plan one pass from the pixels' estimated errors e (plan_pixel_errors()). */
 int plan_make_from(const struct image *acc, const double *e, const struct plan_params *p,

@@ -78,7 +78,8 @@ static const char usage_options[] =
 	"  --keep-workdir        do not remove the work directory after success\n"
 	"  --resume              continue the run the work directory holds\n"
 	"  --error-map FILE      error map EXR (default OUT.errors.exr): error,\n"
-	"                        relerror, samples, order, bandwidth, pass, scales\n"
+	"                        relerror, samples, order, bandwidth, pass, scales,\n"
+	"                        fit (1 where OUT.exr holds the regression's fit)\n"
 	"  --report FILE         JSON report of every pass (default: none)\n"
 	"  --sampler S           how pixels get their samples: auto (default: grid for\n"
 	"                        the scales whose scaled frame would exceed 1 Mpixel,\n"
@@ -93,10 +94,12 @@ static const char usage_options[] =
 	"                        proves worth), or jitter (no scale-2 pass: scales 4, 8\n"
 	"                        and 16 as grid renders, so every sample added to the\n"
 	"                        base pass is jittered); see the README\n"
-	"  --final MODE          what OUT.exr holds per pixel: samples (the mean of the\n"
-	"                        pixel's samples; default), auto (the sample mean or the\n"
-	"                        regression's fit, whichever is predicted closer), or\n"
-	"                        reconstruction (the fit everywhere); see the README\n"
+	"  --final MODE          what OUT.exr holds per pixel: auto (default: the\n"
+	"                        samples' mean, or the regression's fit where the\n"
+	"                        pixel's noise is measured, like its neighbours', and\n"
+	"                        the fit is predicted at most half as far off), samples\n"
+	"                        (the mean of the pixel's samples), or reconstruction\n"
+	"                        (the fit everywhere); see the README\n"
 	"  -q, --quiet           no progress display\n"
 	"  -v, --verbose         progress and details, even when stderr is not a terminal\n"
 	"  -h, --help            this text\n"
@@ -162,7 +165,12 @@ struct run {
 	const char *stop;
 	struct image acc;
 	double *est;		/* w*h: each pixel's estimated relative error, from
-				 * the latest analysis of acc (plan_pixel_errors()) */
+				 * the latest analysis of acc (plan_pixel_errors()),
+				 * the fit's where the final image takes it */
+	double *noise;		/* w*h: the noise part of the samples' (ditto) */
+	unsigned char *take;	/* w*h: the final image takes the fit here
+				 * (accum_final_choose()) */
+	long took;		/* how many take it */
 	/* progress while a pool runs */
 	int pool_done, pool_total, pool_pass;
 };
@@ -405,10 +413,9 @@ static int write_output(struct run *r, const struct lpr_result *res, long *took,
 	struct image out = {0};
 	if (image_init(&out, r->w, r->h, 3, rgb_names, err, errlen))
 		return -1;
-	long t = accum_final_image(&r->acc, res->fit, res->error, res->leverage, r->final,
-				   out.px);
+	accum_final_image(&r->acc, res->fit, r->take, out.px);
 	if (took)
-		*took = t;
+		*took = r->took;
 	int rc = image_write_exr(r->out, &out, err, errlen);
 	image_release(&out);
 	return rc;
@@ -418,16 +425,17 @@ static int write_error_map(struct run *r, const struct lpr_result *res, char *er
 			   size_t errlen)
 {
 	static const char *const names[] = {
-		"error", "relerror", "samples", "order", "bandwidth", "pass", "scales",
+		"error", "relerror", "samples", "order", "bandwidth", "pass", "scales", "fit",
 	};
+	enum { NCH = sizeof names / sizeof names[0] };
 	struct image m = {0};
 	size_t npx = (size_t)r->w * r->h;
 	const double *e = r->est;
-	if (image_init(&m, r->w, r->h, 7, names, err, errlen))
+	if (image_init(&m, r->w, r->h, NCH, names, err, errlen))
 		return -1;
 	for (size_t i = 0; i < npx; i++) {
 		const float *o = r->acc.px + i * ACC_NCH;
-		float *q = m.px + i * 7;
+		float *q = m.px + i * NCH;
 		q[0] = (float)(e[i] * accum_error_scale(&r->acc, i, res->fit + 3 * i));
 		q[1] = (float)e[i];
 		q[2] = o[ACC_SAMPLES];
@@ -435,6 +443,7 @@ static int write_error_map(struct run *r, const struct lpr_result *res, char *er
 		q[4] = res->bandwidth[i];
 		q[5] = o[ACC_PASS];
 		q[6] = o[ACC_SCALES];
+		q[7] = r->take[i];
 	}
 	int rc = image_write_exr(r->error_map, &m, err, errlen);
 	image_release(&m);
@@ -993,7 +1002,7 @@ int cmd_render(int argc, char **argv)
 	r.h = 480;
 	r.target = 1e-3;
 	r.max_passes = 8;
-	r.final = ACC_FINAL_SAMPLES;
+	r.final = ACC_FINAL_AUTO;
 	r.rad_scale = 1;
 	r.user_rad_scale = -1;
 	r.grid = PLAN_GRID_LARGE;
@@ -1206,7 +1215,9 @@ bad:
 		goto fail;
 
 	r.est = malloc((size_t)r.w * r.h * sizeof(*r.est));
-	if (!r.est) {
+	r.noise = malloc((size_t)r.w * r.h * sizeof(*r.noise));
+	r.take = malloc((size_t)r.w * r.h);
+	if (!r.est || !r.noise || !r.take) {
 		errbuf_printf(err, sizeof err, "out of memory");
 		goto fail;
 	}
@@ -1220,8 +1231,12 @@ bad:
 			goto fail;
 		size_t npx = (size_t)r.w * r.h;
 		double est;
-		if (plan_pixel_errors(&r.acc, res.error, res.fit, r.est, &est, err, sizeof err))
+		if (plan_pixel_errors(&r.acc, res.error, res.fit, r.est, r.noise, &est, err,
+				      sizeof err))
 			goto fail;
+		/* which pixels the image written takes from the fit */
+		r.took = accum_final_choose(&r.acc, res.fit, res.error, res.leverage, r.noise,
+					    r.final, r.take, NULL);
 		long left = 0;
 		for (size_t k = 0; k < npx; k++)
 			left += r.est[k] > r.target;
@@ -1262,12 +1277,19 @@ bad:
 		pass++;
 	}
 
-	/* the final image, error map and report */
+	/* the final image, error map and report.  The planner and the stop
+	 * went by the samples' errors; the error map and the estimate are the
+	 * final image's, the fit's predicted error where it takes the fit */
 	long took = 0;
+	r.took = accum_final_choose(&r.acc, res.fit, res.error, res.leverage, r.noise, r.final,
+				    r.take, r.est);
+	double est = 0.0;
+	for (size_t k = 0; k < (size_t)r.w * r.h; k++)
+		est += r.est[k];
+	est /= (double)r.w * r.h;
 	if (write_output(&r, &res, &took, err, sizeof err) ||
 	    write_error_map(&r, &res, err, sizeof err))
 		goto fail;
-	double est = r.passes[r.npasses - 1].est_relmse;
 	if (r.report && write_report(&r, est, err, sizeof err))
 		goto fail;
 	if (!r.quiet && (r.tty || r.verbose)) {
@@ -1312,5 +1334,7 @@ done:
 	image_release(&r.acc);
 	free(r.passes);
 	free(r.est);
+	free(r.noise);
+	free(r.take);
 	return ret;
 }

@@ -1066,7 +1066,7 @@ static void test_pixel_errors(void **state)
 	set_px(&acc, 6, 6, 5.0f, 1e-6f, 2.5e-5f);
 	double est;
 	char err[256];
-	assert_int_equal(plan_pixel_errors(&acc, press, fit, e, &est, err, sizeof(err)), 0);
+	assert_int_equal(plan_pixel_errors(&acc, press, fit, e, NULL, &est, err, sizeof(err)), 0);
 
 	const double flat_bias = want_bias(accpx(&acc, 0)), edge_bias = want_bias(accpx(&acc, 21));
 	double got;
@@ -1130,6 +1130,110 @@ static void test_pixel_errors(void **state)
 	got = accum_pixel_error(&acc, 0, 1e-6, fit, NAN);
 	assert_close(got, 5.0 / 5.0 / (0.83 * 0.83 + 0.01) * want_bias(o), 1e-5, 0.0,
 		     "variance of the mean");
+	image_release(&acc);
+}
+
+/* 6c. The final image's choice between a pixel's samples and the fit. */
+static int choose_centre(struct image *acc, const float *fit, float press, float lev,
+			 double noise_abs, enum accum_final mode, double *e_centre)
+{
+	enum { N = 5, C = 12 };
+	float pr[N * N], lv[N * N];
+	double noise[N * N], e[N * N];
+	unsigned char take[N * N];
+	const double sc = 0.5 * 0.5 + 0.01;
+
+	for (int i = 0; i < N * N; i++) {
+		pr[i] = press;
+		lv[i] = lev;
+		noise[i] = noise_abs / sc;
+		e[i] = noise[i];
+	}
+	if (e_centre)
+		e[C] = *e_centre;
+	long took = accum_final_choose(acc, fit, pr, lv, noise, mode, take, e);
+	long want = 0;
+	for (int i = 0; i < N * N; i++)
+		want += take[i];
+	assert_int_equal(took, want);
+	if (e_centre)
+		*e_centre = e[C];
+	return take[C];
+}
+
+static void test_final_choice(void **state)
+{
+	enum { N = 5, C = 12 };
+	struct image acc;
+	float fit[3 * N * N], rgb[3 * N * N];
+	const double sc = 0.5 * 0.5 + 0.01;
+
+	(void)state;
+	make_acc(&acc, N, N, flat_value);
+	/* 21 samples of variance 0.21: their mean's is 0.01; a fold
+	 * difference each */
+	for (int y = 0; y < N; y++)
+		for (int x = 0; x < N; x++)
+			set_px(&acc, x, y, 21.0f, 0.21f, 0.01f);
+	for (int i = 0; i < 3 * N * N; i++)
+		fit[i] = 0.6f;	/* one standard deviation off */
+
+	/* noise: PRESS no more than the noise (no bias), leverage 0.1: the fit
+	 * misses by 0.01^2 of the samples' 0.01 */
+	double e = 0.01 / sc;
+	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, &e));
+	assert_close(e, 0.1 * 0.1 * 0.01 / sc, 1e-5, 0.0, "the fit's error");
+	assert_false(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_SAMPLES, NULL));
+	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_RECONSTRUCTION, NULL));
+	/* an edge between the samples was the larger part of the estimate:
+	 * the fit is taken, the estimate stays */
+	e = 0.5;
+	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, &e));
+	assert_true(e == 0.5);
+	/* the fit's bias: PRESS 0.05, so (1 - 0.1)^2 0.04 > 0.5 x 0.01 */
+	assert_false(choose_centre(&acc, fit, 0.05f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL));
+	/* the fit 2.5 standard deviations off */
+	for (int c = 0; c < 3; c++)
+		fit[3 * C + c] = 0.75f;
+	assert_false(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL));
+	for (int c = 0; c < 3; c++)
+		fit[3 * C + c] = 0.6f;
+	/* stratified samples of a detail: the fold difference says the mean
+	 * is off by 0.01, a tenth of what its sample variance says, so the fit
+	 * is 10 of its errors away (the sample variance alone would have
+	 * taken it) */
+	assert_false(choose_centre(&acc, fit, 1e-4f, 0.1f, 1e-4, ACC_FINAL_AUTO, NULL));
+	/* no fold difference: noise not measured */
+	accpx(&acc, C)[ACC_DIFF] = NAN;
+	assert_false(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL));
+	accpx(&acc, C)[ACC_DIFF] = 0.01f;
+	/* noisier than its neighbours by 16 (a highlight among dark pixels):
+	 * not theirs; by 2, alike */
+	set_px(&acc, 2, 2, 21.0f, 16 * 0.21f, 0.01f);
+	assert_false(choose_centre(&acc, fit, 0.16f, 0.1f, 0.16, ACC_FINAL_AUTO, NULL));
+	set_px(&acc, 2, 2, 21.0f, 2 * 0.21f, 0.01f);
+	assert_true(choose_centre(&acc, fit, 0.02f, 0.1f, 0.02, ACC_FINAL_AUTO, NULL));
+	/* smoother than them by 16 (the fit 0.8 of its standard deviations
+	 * off): the fit is theirs, not its; by 2, alike */
+	for (int c = 0; c < 3; c++)
+		fit[3 * C + c] = 0.52f;
+	set_px(&acc, 2, 2, 21.0f, 0.21f / 16, 0.01f);
+	assert_false(choose_centre(&acc, fit, 0.01f / 16, 0.1f, 0.01 / 16, ACC_FINAL_AUTO, NULL));
+	set_px(&acc, 2, 2, 21.0f, 0.21f / 2, 0.01f);
+	assert_true(choose_centre(&acc, fit, 0.01f / 2, 0.1f, 0.01 / 2, ACC_FINAL_AUTO, NULL));
+	/* fewer than 4 samples keep them; none take the fit */
+	set_px(&acc, 2, 2, 2.0f, 0.21f, NAN);
+	assert_false(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL));
+	set_px(&acc, 2, 2, 0.0f, 0.0f, NAN);
+	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL));
+
+	/* the image: the fit where taken, else the samples' mean */
+	unsigned char take[N * N] = {0};
+	take[3] = 1;
+	accum_final_image(&acc, fit, take, rgb);
+	for (int i = 0; i < N * N; i++)
+		for (int c = 0; c < 3; c++)
+			assert_true(rgb[3 * i + c] == (i == 3 ? 0.6f : accpx(&acc, (size_t)i)[c]));
 	image_release(&acc);
 }
 
@@ -1349,6 +1453,7 @@ int main(void)
 		cmocka_unit_test(test_plan_make),
 		cmocka_unit_test(test_plan_budget),
 		cmocka_unit_test(test_pixel_errors),
+		cmocka_unit_test(test_final_choice),
 		cmocka_unit_test(test_regions_file),
 		cmocka_unit_test(test_plan_job),
 	};
