@@ -650,9 +650,11 @@ long accum_final_choose(const struct image *acc, const float *fit, const float *
 				use_fit = pred < ACC_FIT_GAIN * u && d2 <= 4.0 * u &&
 					  noise_alike(acc, i);
 				/* the pixel's error is then the fit's, unless an
-				 * edge between its samples was the larger part */
+				 * edge between its samples was the larger part;
+				 * at least a quarter of the samples' (see
+				 * ACC_FIT_FLOOR) */
 				if (use_fit && e && !(e[i] > noise[i]))
-					e[i] = pred / sc;
+					e[i] = (pred > ACC_FIT_FLOOR * u ? pred : ACC_FIT_FLOOR * u) / sc;
 			}
 		}
 		take[i] = (unsigned char)use_fit;

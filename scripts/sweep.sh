@@ -5,7 +5,7 @@
 # at s*W x s*H with antialiasing off, box-average each s x s block); the
 # lower envelope of all its runs is the bar povpress must beat.
 #
-# usage: scripts/sweep.sh [--quick] [--size WxH] [SCENE.pov ...]
+# usage: scripts/sweep.sh [--quick] [--size WxH] [--repeat N] [SCENE.pov ...]
 #        make sweep [SWEEP_ARGS="--quick scenes/media.pov"]; make bench (quick)
 #
 # Default: every scenes/*.pov at 160x120.  Needs build/povpress and
@@ -31,7 +31,11 @@
 #   am2       +AM2, the same thresholds and depths, +J
 #   scale     s = 1, 2, 3, 4: +W(s W) +H(s H) -A, then boxdown
 #   povpress  `povpress render` at --target 3e-3, 1e-3, 3e-4, 1e-4 and at
-#             --budget 2, 4, 8 seconds (with --target 1e-6), its defaults
+#             --budget 2, 4, 8 seconds (with --target 1e-6), its defaults;
+#             each setting N times (--repeat N, 1 to 9; default 3, 1 with
+#             --quick), sweep.csv keeping the run whose ratio to POV-Ray's
+#             lower envelope at its CPU time is the median: its plans hang
+#             on measured timings, and one run's ratio swings 2-4x
 # (--quick: thresholds 0.3, 0.03, 0.0, depths 2, 3, targets 3e-3 and 1e-3,
 # budget 3.)  Every POV-Ray run is one process,
 #   povray -D -GA +FE +WT1 +W.. +H.. +O.. +I<scene> +L<scene's dir> [options]
@@ -47,6 +51,7 @@
 # Output, in $BUILD/sweep/:
 #   sweep.csv        scene,method,setting,cpu_s,wall_s,relmse,psnr,
 #                    est_relmse,capture20,oracle20 (the last three for povpress)
+#   repeats.csv      the same columns, every povpress run (with --repeat 2+)
 #   <scene>.png      relMSE against CPU seconds, log-log, one series per
 #                    method, povpress's runs, and POV-Ray's lower envelope
 #                    (the best relMSE any POV-Ray run reaches within each
@@ -70,11 +75,18 @@ CACHE=${POVPRESS_CACHE:-$HOME/.cache/povpress}/ref
 OUT=$BUILD/sweep
 
 quick=0
+repeat=
 size=160x120
 scenes=()
 while (($#)); do
 	case $1 in
 	--quick) quick=1 ;;
+	--repeat)
+		[[ $# -ge 2 ]] || { echo "sweep: --repeat needs a count" >&2; exit 2; }
+		repeat=$2
+		shift
+		;;
+	--repeat=*) repeat=${1#--repeat=} ;;
 	--size)
 		[[ $# -ge 2 ]] || { echo "sweep: --size needs WxH" >&2; exit 2; }
 		size=$2
@@ -94,6 +106,15 @@ if [[ ! $size =~ ^([1-9][0-9]{0,4})x([1-9][0-9]{0,4})$ ]]; then
 fi
 W=${BASH_REMATCH[1]}
 H=${BASH_REMATCH[2]}
+if [[ -z $repeat ]]; then
+	REPEAT=3
+	((quick)) && REPEAT=1
+elif [[ $repeat =~ ^[1-9]$ ]]; then
+	REPEAT=$repeat
+else
+	echo "sweep: invalid --repeat '$repeat': expected a count from 1 to 9" >&2
+	exit 2
+fi
 ((${#scenes[@]})) || scenes=("$ROOT"/scenes/*.pov)
 
 # Odd reference scales: their sample grids share no position with the grids
@@ -324,7 +345,36 @@ done
 # ---- the sweep
 
 CSV=$OUT/sweep.csv
+RCSV=$OUT/repeats.csv
 echo "scene,method,setting,cpu_s,wall_s,relmse,psnr,est_relmse,capture20,oracle20" >"$CSV.tmp"
+rm -f "$RCSV" "$RCSV.tmp"
+((REPEAT == 1)) || head -n 1 "$CSV.tmp" >"$RCSV.tmp"
+
+# median_row NAME ROW...: of povpress's repeated runs (CSV rows), the one
+# whose ratio to NAME's POV-Ray lower envelope at its CPU time is the median
+# (the lower of the middle two for an even count).  NAME's POV-Ray runs are
+# in $CSV.tmp already: they come before povpress's.
+median_row() {
+	local name=$1
+	shift
+	printf '%s\n' "$@" | awk -F, -v n="$name" '
+		NR == FNR { if ($1 == n && $2 != "povpress") { k++; C[k] = $4; R[k] = $6 }; next }
+		{
+			be = ""
+			for (j = 1; j <= k; j++)
+				if (C[j] <= $4 && (be == "" || R[j] < be)) be = R[j]
+			m++; r[m] = be == "" ? 1e300 : $6 / be; row[m] = $0
+		}
+		END {
+			for (a = 1; a <= m; a++) {
+				below = 0
+				for (b = 1; b <= m; b++)
+					if (r[b] < r[a] || (r[b] == r[a] && b < a)) below++
+				if (below == int((m - 1) / 2)) { print row[a]; exit 0 }
+			}
+			exit 1
+		}' "$CSV.tmp" -
+}
 runs=("noaa|-|noaa|-A")
 for m in 1 2; do
 	for a in "${THRESHOLDS[@]}"; do
@@ -355,45 +405,61 @@ for i in "${!scenes[@]}"; do
 		k=$((k + 1))
 		s=1
 		[[ $method == scale ]] && s=$setting
-		img=$dir/$tag.exr
-		render=$img
-		((s == 1)) || render=$dir/$tag-hi.exr
-		pov_args $((s * W)) $((s * H)) "$render" "$sc"
-		if [[ $method == povpress ]]; then
-			# shellcheck disable=SC2086 # opts is a list of povpress options
-			job_start timed_povpress "$dir/$tag.time" "$dir/$tag.log" "$sc" "$img" \
-				"$dir/$tag.json" $opts
+		reps=1
+		[[ $method == povpress ]] && reps=$REPEAT
+		rows=()
+		for ((rep = 1; rep <= reps; rep++)); do
+			rtag=$tag
+			((rep == 1)) || rtag=$tag-r$rep
+			img=$dir/$rtag.exr
+			render=$img
+			((s == 1)) || render=$dir/$rtag-hi.exr
+			pov_args $((s * W)) $((s * H)) "$render" "$sc"
+			if [[ $method == povpress ]]; then
+				# shellcheck disable=SC2086 # opts is a list of povpress options
+				job_start timed_povpress "$dir/$rtag.time" "$dir/$rtag.log" "$sc" "$img" \
+					"$dir/$rtag.json" $opts
+			else
+				# shellcheck disable=SC2086 # opts is a list of POV-Ray options
+				job_start timed_povray "$dir/$rtag.time" "$dir/$rtag.log" "${POV[@]}" $opts
+			fi
+			if ! job_wait "$JOB"; then
+				tail -n 15 "$dir/$rtag.log" >&2
+				die "povray failed on '$sc' ($method $setting); log in $dir/$rtag.log"
+			fi
+			if ((s > 1)); then
+				"$BOXDOWN" "$render" "$s" "$img" || die "cannot box-average '$render'"
+				rm -f "$render"
+			fi
+			read -r u sy wall < <(tail -n 1 "$dir/$rtag.time")
+			cpu=$(awk -v u="$u" -v s="$sy" 'BEGIN { printf "%.3f", u + s }')
+			cmp=$("$POVPRESS" compare "$img" "${REF[$sc]}") || die "cannot compare '$img'"
+			relmse=$(sed -n 's/^relmse: //p' <<<"$cmp")
+			psnr=$(sed -n 's/^psnr: //p' <<<"$cmp")
+			fid=,,
+			if [[ $method == povpress ]]; then
+				# the loop's own estimate, and how well its error map ranks pixels
+				cmp=$("$POVPRESS" compare "$img" "${REF[$sc]}" --analysis "${img%.exr}.errors.exr") ||
+					die "cannot judge the error map of '$img'"
+				fid="$(sed -n 's/^est_relmse: //p' <<<"$cmp"),$(sed -n 's/^capture20: //p' <<<"$cmp"),$(sed -n 's/^oracle20: //p' <<<"$cmp")"
+			fi
+			rows+=("$name,$method,$setting,$cpu,$wall,$relmse,$psnr,$fid")
+			rn=
+			((reps == 1)) || rn=" (run $rep of $reps)"
+			printf 'sweep: [%d/%d] %s %s %s%s: %s s CPU, %s s wall, relMSE %s (%s)\n' \
+				"$k" "$total" "$name" "$method" "$setting" "$rn" "$cpu" "$wall" "$relmse" \
+				"$(elapsed)" >&2
+		done
+		if ((reps > 1)); then
+			median_row "$name" "${rows[@]}" >>"$CSV.tmp" || die "no median of '$name' $setting"
+			printf '%s\n' "${rows[@]}" >>"$RCSV.tmp"
 		else
-			# shellcheck disable=SC2086 # opts is a list of POV-Ray options
-			job_start timed_povray "$dir/$tag.time" "$dir/$tag.log" "${POV[@]}" $opts
+			echo "${rows[0]}" >>"$CSV.tmp"
 		fi
-		if ! job_wait "$JOB"; then
-			tail -n 15 "$dir/$tag.log" >&2
-			die "povray failed on '$sc' ($method $setting); log in $dir/$tag.log"
-		fi
-		if ((s > 1)); then
-			"$BOXDOWN" "$render" "$s" "$img" || die "cannot box-average '$render'"
-			rm -f "$render"
-		fi
-		read -r u sy wall < <(tail -n 1 "$dir/$tag.time")
-		cpu=$(awk -v u="$u" -v s="$sy" 'BEGIN { printf "%.3f", u + s }')
-		cmp=$("$POVPRESS" compare "$img" "${REF[$sc]}") || die "cannot compare '$img'"
-		relmse=$(sed -n 's/^relmse: //p' <<<"$cmp")
-		psnr=$(sed -n 's/^psnr: //p' <<<"$cmp")
-		fid=,,
-		if [[ $method == povpress ]]; then
-			# the loop's own estimate, and how well its error map ranks pixels
-			cmp=$("$POVPRESS" compare "$img" "${REF[$sc]}" --analysis "${img%.exr}.errors.exr") ||
-				die "cannot judge the error map of '$img'"
-			fid="$(sed -n 's/^est_relmse: //p' <<<"$cmp"),$(sed -n 's/^capture20: //p' <<<"$cmp"),$(sed -n 's/^oracle20: //p' <<<"$cmp")"
-		fi
-		echo "$name,$method,$setting,$cpu,$wall,$relmse,$psnr,$fid" >>"$CSV.tmp"
-		printf 'sweep: [%d/%d] %s %s %s: %s s CPU, %s s wall, relMSE %s (%s)\n' \
-			"$k" "$total" "$name" "$method" "$setting" "$cpu" "$wall" "$relmse" \
-			"$(elapsed)" >&2
 	done
 done
 mv "$CSV.tmp" "$CSV"
+[[ ! -e $RCSV.tmp ]] || mv "$RCSV.tmp" "$RCSV"
 
 # ---- plots
 
@@ -642,6 +708,10 @@ echo "$PPT" | awk -F'|' '{ printf "%-18s %-14s cpu %6s  relMSE %-9s POV-Ray %-22
 	echo "over povpress's CPU (above 1 povpress is faster). \"est/true\" is povpress's"
 	echo "estimated relMSE over the true one; \"capture20\" the share of the true error in"
 	echo "the 20% of pixels its error map ranks highest, next to an oracle's share."
+	if ((REPEAT > 1)); then
+		echo "Each setting ran $REPEAT times; the row is the run with the median ratio"
+		echo "(every run is in repeats.csv)."
+	fi
 	echo
 	echo "| scene | run | CPU s | wall s | relMSE | POV-Ray at equal CPU | ratio | equal-error speed-up | est/true | capture20 / oracle |"
 	echo "|---|---|---|---|---|---|---|---|---|---|"

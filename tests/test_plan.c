@@ -1179,10 +1179,16 @@ static void test_final_choice(void **state)
 		fit[i] = 0.6f;	/* one standard deviation off */
 
 	/* noise: PRESS no more than the noise (no bias), leverage 0.1: the fit
-	 * misses by 0.01^2 of the samples' 0.01 */
+	 * is predicted to miss by 0.1^2 of the samples' 0.01, and is charged
+	 * the floor, a quarter of it */
 	double e = 0.01 / sc;
 	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, &e));
-	assert_close(e, 0.1 * 0.1 * 0.01 / sc, 1e-5, 0.0, "the fit's error");
+	assert_close(e, ACC_FIT_FLOOR * 0.01 / sc, 1e-5, 0.0, "the fit's error, floored");
+	/* a bias of 0.0037: predicted 0.1^2 0.01 + 0.9^2 0.0037, above the floor */
+	e = 0.01 / sc;
+	assert_true(choose_centre(&acc, fit, 0.0137f, 0.1f, 0.01, ACC_FINAL_AUTO, &e));
+	assert_close(e, (0.1 * 0.1 * 0.01 + 0.9 * 0.9 * (0.0137 - 0.01)) / sc, 1e-5, 0.0,
+		     "the fit's error");
 	assert_false(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_SAMPLES, NULL));
 	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_RECONSTRUCTION, NULL));
 	/* an edge between the samples was the larger part of the estimate:
