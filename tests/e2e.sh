@@ -214,6 +214,29 @@ povray -D -GA +W96 +H72 +FE +WT1 Declare=AreaN=12 "+O$T/ref.exr" "+I$T/scene.pov
 out=$("$PP" compare "$T/render.exr" "$T/ref.exr")
 check "render: compare against a 12x12-light render" num 'a > 0' "$(cmpval "$out" relmse)"
 
+# --- the benchmark's choice among repeated runs -------------------------------
+# median_row, as scripts/sweep.sh defines it: of repeated povpress rows, the
+# one whose ratio to the scene's POV-Ray envelope (in $CSV.tmp) is the median
+eval "$(sed -n '/^median_row() {/,/^}/p' "$ROOT/scripts/sweep.sh")"
+CSV=$T/sweep.csv
+printf '%s\n' scene,method,setting,cpu_s,wall_s,relmse,psnr,est,cap,orc \
+	A,noaa,-,0.1,1,0.01,,,, A,am2,x,1.0,1,0.001,,,, B,am2,x,0.01,1,1e-9,,,, >"$CSV.tmp"
+# ratios 0.4 (0.004 over 0.01 at 0.5 s), 2 (0.002 over 0.001), 3 (0.03 over 0.01)
+m=$(median_row A A,povpress,t,0.5,1,0.004,,,, A,povpress,t,1.5,1,0.002,,,, \
+	A,povpress,t,0.2,1,0.03,,,,)
+check "sweep: the median-ratio run of three (not the median relMSE or CPU)" \
+	test "$m" = A,povpress,t,1.5,1,0.002,,,,
+m=$(median_row A A,povpress,t,0.5,1,0.004,,,, A,povpress,t,1.5,1,0.0005,,,,)
+check "sweep: the lower of the middle two of two (0.4 and 0.5)" \
+	test "$m" = A,povpress,t,0.5,1,0.004,,,,
+m=$(median_row A A,povpress,t,0.05,1,0.001,,,, A,povpress,t,0.5,1,0.02,,,, \
+	A,povpress,t,0.5,1,0.01,,,,)
+check "sweep: a run cheaper than every POV-Ray run ranks last" \
+	test "$m" = A,povpress,t,0.5,1,0.02,,,,
+"$ROOT/scripts/sweep.sh" --repeat 0 >"$T/rep.out" 2>&1
+check "sweep: --repeat 0 is a usage error (2)" test $? -eq 2
+check "sweep: ... naming --repeat" grep -q -- "--repeat '0'" "$T/rep.out"
+
 # --- every bundled scene renders and analyses -------------------------------------
 for scene in "$ROOT"/scenes/*.pov; do
 	name=$(basename "$scene" .pov)
