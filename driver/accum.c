@@ -428,6 +428,19 @@ static int finest_scale(const struct image *acc, size_t i)
 	return best;
 }
 
+/* Pixel i's eight neighbours inside the image (row by row), into q; returns
+ * how many. */
+static int neighbours8(const struct image *acc, size_t i, const float *q[8])
+{
+	const int w = acc->w, h = acc->h, x = (int)(i % (size_t)w), y = (int)(i / (size_t)w);
+	int k = 0;
+	for (int dy = -1; dy <= 1; dy++)
+		for (int dx = -1; dx <= 1; dx++)
+			if ((dx || dy) && x + dx >= 0 && x + dx < w && y + dy >= 0 && y + dy < h)
+				q[k++] = acc->px + ((size_t)(y + dy) * w + (x + dx)) * ACC_NCH;
+	return k;
+}
+
 /*
  * The expected relative squared error of pixel i from an edge hidden
  * between its samples and its neighbours': for each neighbour and channel,
@@ -441,34 +454,30 @@ static int finest_scale(const struct image *acc, size_t i)
  */
 static double hidden_edge(const struct image *acc, size_t i, int s)
 {
-	const int w = acc->w, h = acc->h, x = (int)(i % (size_t)w), y = (int)(i / (size_t)w);
-	const float *o = acc->px + i * ACC_NCH;
-	const int own = o[ACC_SAMPLES] >= 4.0f;
+	const float *o = acc->px + i * ACC_NCH, *nb[8];
+	const int own = o[ACC_SAMPLES] >= 4.0f, nn = neighbours8(acc, i, nb);
 	double best = 0.0;
-	for (int dy = -1; dy <= 1; dy++)
-		for (int dx = -1; dx <= 1; dx++) {
-			if ((!dx && !dy) || x + dx < 0 || x + dx >= w || y + dy < 0 || y + dy >= h)
+	for (int j = 0; j < nn; j++) {
+		const float *q = nb[j];
+		if (!(q[ACC_SAMPLES] > 0.0f))
+			continue;
+		const int theirs = q[ACC_SAMPLES] >= 4.0f;
+		double e = 0.0;
+		for (int c = 0; c < 3; c++) {
+			double d = (double)q[c] - o[c], v = o[c];
+			double h2 = d * d - 12.0 * ((own ? o[ACC_VAR_R + c] : 0.0) +
+						    (theirs ? q[ACC_VAR_R + c] : 0.0));
+			if (!(h2 > 0.0))
 				continue;
-			const float *q = acc->px + ((size_t)(y + dy) * w + (x + dx)) * ACC_NCH;
-			if (!(q[ACC_SAMPLES] > 0.0f))
-				continue;
-			const int theirs = q[ACC_SAMPLES] >= 4.0f;
-			double e = 0.0;
-			for (int c = 0; c < 3; c++) {
-				double d = (double)q[c] - o[c], v = o[c];
-				double h2 = d * d - 12.0 * ((own ? o[ACC_VAR_R + c] : 0.0) +
-							    (theirs ? q[ACC_VAR_R + c] : 0.0));
-				if (!(h2 > 0.0))
-					continue;
-				double dh = d > 0.0 ? sqrt(h2) : -sqrt(h2);
-				for (int k = 0; k < 4; k++) {
-					double m = (k + 0.5) / (8.0 * s) * dh;
-					e += m * m / ((v + m) * (v + m) + METRICS_RELMSE_EPS) / 12.0;
-				}
+			double dh = d > 0.0 ? sqrt(h2) : -sqrt(h2);
+			for (int k = 0; k < 4; k++) {
+				double m = (k + 0.5) / (8.0 * s) * dh;
+				e += m * m / ((v + m) * (v + m) + METRICS_RELMSE_EPS) / 12.0;
 			}
-			if (e > best)
-				best = e;
 		}
+		if (e > best)
+			best = e;
+	}
 	return isfinite(best) ? best : 1.0;
 }
 
@@ -598,23 +607,19 @@ double accum_pixel_error(const struct image *acc, size_t i, double press, const 
 #define ACC_FIT_ALIKE 4.0
 static int noise_alike(const struct image *acc, size_t i)
 {
-	const int w = acc->w, h = acc->h, x = (int)(i % (size_t)w), y = (int)(i / (size_t)w);
-	const float *o = acc->px + i * ACC_NCH;
+	const float *o = acc->px + i * ACC_NCH, *nb[8];
 	const double vi = ((double)o[ACC_VAR_R] + o[ACC_VAR_G] + o[ACC_VAR_B]) / o[ACC_SAMPLES];
+	const int nn = neighbours8(acc, i, nb);
 	double sl = 0.0;
 	int k = 0;
-	for (int dy = -1; dy <= 1; dy++)
-		for (int dx = -1; dx <= 1; dx++) {
-			if ((!dx && !dy) || x + dx < 0 || x + dx >= w || y + dy < 0 || y + dy >= h)
-				continue;
-			const float *q = acc->px + ((size_t)(y + dy) * w + (x + dx)) * ACC_NCH;
-			if (!(q[ACC_SAMPLES] >= 2.0f))
-				continue;
-			double vq = ((double)q[ACC_VAR_R] + q[ACC_VAR_G] + q[ACC_VAR_B]) /
-				    q[ACC_SAMPLES];
-			sl += log((vq + 1e-30) / (vi + 1e-30));
-			k++;
-		}
+	for (int j = 0; j < nn; j++) {
+		const float *q = nb[j];
+		if (!(q[ACC_SAMPLES] >= 2.0f))
+			continue;
+		double vq = ((double)q[ACC_VAR_R] + q[ACC_VAR_G] + q[ACC_VAR_B]) / q[ACC_SAMPLES];
+		sl += log((vq + 1e-30) / (vi + 1e-30));
+		k++;
+	}
 	return k > 0 && isfinite(sl) && fabs(sl / k) <= log(ACC_FIT_ALIKE);
 }
 
