@@ -46,7 +46,7 @@ struct plan_params {
 				 * samples cost this much (seconds; default 0:
 				 * never).  For a pass that may be the last. */
 	int min_split;		/* split the dearest regions in two, up to
-				 * max_regions, until none costs more than the
+				 * 2 max_regions, until none costs more than the
 				 * pass over min_split (the cores that render
 				 * it at once; default 0: no splitting) */
 };

@@ -1187,7 +1187,7 @@ void pov_pool_opts_init(struct pov_pool_opts *opts)
 }
 
 enum { J_PENDING, J_RUNNING, J_DONE };
-enum { STOP_NONE, STOP_TIMEOUT, STOP_CANCEL };
+enum { STOP_NONE, STOP_TIMEOUT, STOP_CANCEL, STOP_DEADLINE };
 
 struct pjob {
 	struct cmd cmd;
@@ -1434,6 +1434,9 @@ static int finish(struct pjob *j, const struct pov_pool_opts *opts, double t0,
 
 		report(res, POV_CANCELLED, "povray stopped by %s rendering '%s'",
 		       sig ? signame(sig) : "an interruption", j->cmd.output);
+	} else if (j->stop == STOP_DEADLINE) {
+		report(res, POV_CANCELLED, "povray stopped past the deadline (%g s) rendering '%s'",
+		       opts->deadline_s, j->cmd.output);
 	} else if (j->stop == STOP_TIMEOUT) {
 		report(res, POV_TIMED_OUT, "povray timed out after %g s rendering '%s'",
 		       opts->timeout_s, j->cmd.output);
@@ -1467,6 +1470,7 @@ struct pool {
 	size_t next;		/* no pending job before this index */
 	size_t running, done;
 	int stopping;		/* a signal arrived: start nothing, stop all */
+	int past;		/* past opts->deadline_s: start nothing, stop all */
 	int devnull;
 	double t0;
 	int ino;		/* inotify descriptor when opts->ready, or -1 */
@@ -1545,7 +1549,7 @@ static void job_final(struct pool *p, size_t i)
 /* Start pending jobs while there are free slots. */
 static void pool_fill(struct pool *p)
 {
-	while (!p->stopping && p->running < (size_t)p->opts->max_jobs) {
+	while (!p->stopping && !p->past && p->running < (size_t)p->opts->max_jobs) {
 		struct pjob *j;
 
 		while (p->next < p->n && p->pj[p->next].state != J_PENDING)
@@ -1588,6 +1592,8 @@ static void pool_wait(struct pool *p)
 		if (j->kill_at && !j->killed && j->kill_at - now < wait_s)
 			wait_s = j->kill_at - now;
 	}
+	if (p->opts->deadline_s > 0 && !p->past && p->t0 + p->opts->deadline_s - now < wait_s)
+		wait_s = p->t0 + p->opts->deadline_s - now;
 	if (eof_seen && wait_s > 0.005)
 		wait_s = 0.005;	/* its output is closed: the exit is imminent */
 	if (wait_s < 0)
@@ -1628,7 +1634,7 @@ static void pool_check(struct pool *p)
 		if (waitid(P_PID, (id_t)j->pid, &si, WEXITED | WNOHANG | WNOWAIT) == 0 &&
 		    si.si_pid == j->pid) {
 			p->running--;
-			if (finish(j, p->opts, p->t0, &p->res[i], p->stopping)) {
+			if (finish(j, p->opts, p->t0, &p->res[i], p->stopping || p->past)) {
 				j->state = J_PENDING;	/* retry */
 				if (i < p->next)
 					p->next = i;
@@ -1731,22 +1737,32 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 				if (p.pj[i].state == J_RUNNING)
 					stop_job(&p.pj[i], STOP_CANCEL, now_s(), opts->grace_s);
 		}
+		if (!p.past && opts->deadline_s > 0 && now_s() - p.t0 >= opts->deadline_s) {
+			p.past = 1;
+			for (size_t i = 0; i < njobs; i++)
+				if (p.pj[i].state == J_RUNNING)
+					stop_job(&p.pj[i], STOP_DEADLINE, now_s(), 0.05);
+		}
 		pool_fill(&p);
-		if (!p.running && (p.stopping || p.done == njobs))
+		if (!p.running && (p.stopping || p.past || p.done == njobs))
 			break;
 		pool_wait(&p);
 		pool_check(&p);
 	}
-	/* Only an interruption leaves jobs pending.  One that already ran keeps
-	 * the result of its last attempt. */
+	/* Only an interruption or the deadline leaves jobs pending.  One that
+	 * already ran keeps the result of its last attempt. */
 	for (size_t i = 0; i < njobs; i++) {
 		if (p.pj[i].state != J_PENDING)
 			continue;
 		if (results[i].attempts == 0) {
 			int sig = pov_signal_received();
 
-			report(&results[i], POV_CANCELLED, "not started: interrupted by %s",
-			       sig ? signame(sig) : "a signal");
+			if (p.stopping)
+				report(&results[i], POV_CANCELLED, "not started: interrupted by %s",
+				       sig ? signame(sig) : "a signal");
+			else
+				report(&results[i], POV_CANCELLED,
+				       "not started: past the deadline (%g s)", opts->deadline_s);
 			results[i].exit_status = -1;
 		}
 		job_final(&p, i);

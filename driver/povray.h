@@ -259,6 +259,10 @@ struct pov_pool_opts {
 	 * job done and POV-Ray killed (for a render whose statistics, printed
 	 * just after the image, or other files are wanted too). */
 	int (*ready_log)(void *arg, size_t index, const char *log);
+	/* If > 0: seconds after the run began when the pool stops: jobs still
+	 * running are killed and, like jobs not started, reported
+	 * POV_CANCELLED ("past the deadline"); pov_pool_run() returns 0. */
+	double deadline_s;
 };
 
 /* Defaults: max_jobs from pov_pool_size() for one job per core, no

@@ -893,6 +893,17 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	po.on_done = on_done;
 	po.ready = output_whole;
 	po.arg = r;
+	if (r->budget > 0.0) {
+		/* the budget holds even when the cost model is wrong (a region
+		 * of glossy floor costs more per sample than the frame's
+		 * average: glossy_reflection at --budget 8 ended at 10.9 s):
+		 * regions still rendering when only the analysis's time is
+		 * left are stopped, and what they did is lost */
+		double reserve = r->passes[r->npasses - 1].analysis_s + 0.1;
+		po.deadline_s = r->budget - elapsed(r) - reserve;
+		if (po.deadline_s < 0.01)
+			po.deadline_s = 0.01;
+	}
 	r->pool_done = 0;
 	r->pool_total = (int)n;
 	r->pool_pass = pass;

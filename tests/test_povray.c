@@ -1060,6 +1060,56 @@ static void test_pool_ready(void **state)
 	pov_result_release(&res);
 }
 
+/* A deadline: the job running then is killed, those not started are not;
+ * all are reported cancelled, the one done before it keeps its result. */
+static void test_pool_deadline(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], log[PATH_MAX], out[4][PATH_MAX], err[512];
+	struct pov_job jobs[4];
+	struct pov_result res[4];
+	struct pov_pool_opts o;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "deadline"), "s.pov");
+	setenv("FAKE_MODE", "sleep", 1);	/* 0.3 s each */
+	setenv("FAKE_LOG", scratch(log, sizeof(log), "deadline/log"), 1);
+	for (int k = 0; k < 4; k++) {
+		char name[64];
+
+		memset(&jobs[k], 0, sizeof(jobs[k]));
+		snprintf(name, sizeof(name), "deadline/o%d.exr", k);
+		jobs[k].scene = scene;
+		jobs[k].output = scratch(out[k], sizeof(out[k]), name);
+		jobs[k].width = 8;
+		jobs[k].height = 8;
+		jobs[k].povray = fake_bin;
+	}
+	pov_pool_opts_init(&o);
+	o.max_jobs = 1;
+	o.deadline_s = 0.45;
+	double t = now_s();
+	assert_int_equal(pov_pool_run(jobs, 4, &o, res, err, sizeof(err)), 0);
+	t = now_s() - t;
+	assert_true(t < 0.8);	/* not 1.2 s */
+	assert_int_equal(res[0].status, POV_OK);
+	assert_true(exists(out[0]));
+	for (int k = 1; k < 4; k++) {
+		assert_int_equal(res[k].status, POV_CANCELLED);
+		assert_non_null(strstr(res[k].message, "deadline"));
+		assert_false(exists(out[k]));
+	}
+	assert_int_equal(res[1].attempts, 1);	/* killed */
+	assert_int_equal(res[2].attempts, 0);	/* never started */
+	assert_int_equal(res[3].attempts, 0);
+	release_all(res, 4);
+	/* without one, all four run */
+	o.deadline_s = 0.0;
+	assert_int_equal(pov_pool_run(jobs, 4, &o, res, err, sizeof(err)), 0);
+	for (int k = 0; k < 4; k++)
+		assert_int_equal(res[k].status, POV_OK);
+	release_all(res, 4);
+}
+
 static void test_pool_crash_retry_and_no_output(void **state)
 {
 	char scene[PATH_MAX], out[PATH_MAX];
@@ -1483,6 +1533,7 @@ int main(void)
 		cmocka_unit_test(test_render_region),
 		cmocka_unit_test(test_render_parse_error),
 		cmocka_unit_test(test_timeout_kills),
+		cmocka_unit_test(test_pool_deadline),
 		cmocka_unit_test(test_sigint_stops_pool),
 		cmocka_unit_test(test_sigterm_stops_pool),
 		cmocka_unit_test(test_sigkill_leaves_no_orphans),
