@@ -885,6 +885,24 @@ static void count_done(void *arg, size_t index, const struct pov_result *res)
 	calls[index]++;
 }
 
+/* n 8 x 8 jobs of the fake POV-Ray on scene, their outputs DIR/o<k>.exr in
+ * the scratch directory (paths into outs). */
+static void fake_jobs(struct pov_job *jobs, int n, char outs[][PATH_MAX], const char *scene,
+		      const char *dir)
+{
+	for (int k = 0; k < n; k++) {
+		char name[64];
+
+		snprintf(name, sizeof(name), "%s/o%d.exr", dir, k);
+		memset(&jobs[k], 0, sizeof(jobs[k]));
+		jobs[k].scene = scene;
+		jobs[k].output = scratch(outs[k], sizeof(outs[k]), name);
+		jobs[k].width = 8;
+		jobs[k].height = 8;
+		jobs[k].povray = fake_bin;
+	}
+}
+
 /* Never more than K children at once, and K reached. */
 static void test_pool_limit(void **state)
 {
@@ -904,17 +922,7 @@ static void test_pool_limit(void **state)
 	unlink(log);
 	setenv("FAKE_MODE", "sleep", 1);
 	setenv("FAKE_LOG", log, 1);
-	for (int i = 0; i < N; i++) {
-		char name[64];
-
-		snprintf(name, sizeof(name), "limit/o%d.exr", i);
-		memset(&jobs[i], 0, sizeof(jobs[i]));
-		jobs[i].scene = scene;
-		jobs[i].output = scratch(outs[i], sizeof(outs[i]), name);
-		jobs[i].width = 8;
-		jobs[i].height = 8;
-		jobs[i].povray = fake_bin;
-	}
+	fake_jobs(jobs, N, outs, scene, "limit");
 	pov_pool_opts_init(&o);
 	o.max_jobs = K;
 	o.on_done = count_done;
@@ -1073,17 +1081,7 @@ static void test_pool_deadline(void **state)
 	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "deadline"), "s.pov");
 	setenv("FAKE_MODE", "sleep", 1);	/* 0.3 s each */
 	setenv("FAKE_LOG", scratch(log, sizeof(log), "deadline/log"), 1);
-	for (int k = 0; k < 4; k++) {
-		char name[64];
-
-		memset(&jobs[k], 0, sizeof(jobs[k]));
-		snprintf(name, sizeof(name), "deadline/o%d.exr", k);
-		jobs[k].scene = scene;
-		jobs[k].output = scratch(out[k], sizeof(out[k]), name);
-		jobs[k].width = 8;
-		jobs[k].height = 8;
-		jobs[k].povray = fake_bin;
-	}
+	fake_jobs(jobs, 4, out, scene, "deadline");
 	pov_pool_opts_init(&o);
 	o.max_jobs = 1;
 	o.deadline_s = 0.45;
