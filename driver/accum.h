@@ -190,7 +190,8 @@ enum accum_final {
 #define ACC_FIT_GAIN 0.5
 
 /* The error a pixel that takes the fit is then estimated at: the fit's
- * predicted error, but at least this share of its samples'.  The
+ * predicted error, but at least this share of its samples' (of u, in
+ * accum_final_choose()).  The
  * prediction is chosen for being small, and is so too small: 0.38 and 0.43
  * times the true error over the pixels that took the fit (media and
  * glossy_reflection at 160x120, target 1e-3, one run each), where those

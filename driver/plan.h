@@ -34,7 +34,8 @@ struct plan_params {
 	double budget;		/* cost this pass may spend, seconds; 0: no limit */
 	double cost_job;	/* cost of one POV-Ray invocation, seconds */
 	double cost_sample;	/* cost of one sample, seconds */
-	int max_regions;	/* at most this many rectangles (default 64) */
+	int max_regions;	/* at most this many rectangles (default 64),
+				 * twice as many after splitting for min_split */
 	int tile;		/* packing grid in pixels (default 8) */
 	double min_gain;	/* a pixel gaining less than min_gain * target
 				 * is not refined (default 0.05) */

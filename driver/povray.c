@@ -1372,6 +1372,8 @@ static void stop_job(struct pjob *j, int why, double now, double grace)
 	if (!j->kill_at) {
 		kill(-j->pid, SIGTERM);
 		j->kill_at = now + grace;
+	} else if (now + grace < j->kill_at) {
+		j->kill_at = now + grace;	/* a deadline sooner than a timeout's grace */
 	}
 }
 
@@ -1738,6 +1740,11 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 					stop_job(&p.pj[i], STOP_CANCEL, now_s(), opts->grace_s);
 		}
 		if (!p.past && opts->deadline_s > 0 && now_s() - p.t0 >= opts->deadline_s) {
+			/* outputs closed just before it still count */
+			if (p.ino >= 0) {
+				pool_notice(&p);
+				pool_early(&p);
+			}
 			p.past = 1;
 			for (size_t i = 0; i < njobs; i++)
 				if (p.pj[i].state == J_RUNNING)

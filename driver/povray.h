@@ -260,8 +260,11 @@ struct pov_pool_opts {
 	 * just after the image, or other files are wanted too). */
 	int (*ready_log)(void *arg, size_t index, const char *log);
 	/* If > 0: seconds after the run began when the pool stops: jobs still
-	 * running are killed and, like jobs not started, reported
-	 * POV_CANCELLED ("past the deadline"); pov_pool_run() returns 0. */
+	 * running (but those whose output ready() has accepted) are killed and
+	 * reported POV_CANCELLED ("past the deadline"), unless they exit with
+	 * their output first (POV_OK); jobs not started are reported
+	 * POV_CANCELLED, or, if they had an attempt, keep its result; no
+	 * retries; pov_pool_run() returns 0. */
 	double deadline_s;
 };
 

@@ -61,7 +61,8 @@ static const char usage_options[] =
 	"  -H, --height N        image height (default 480)\n"
 	"  --target RELMSE       estimated relMSE to stop at (default 0.001)\n"
 	"  --budget SECONDS      wall-clock seconds to stop within (default: none;\n"
-	"                        region renders still running at its end are stopped)\n"
+	"                        region renders still running when only the last\n"
+	"                        analysis's time is left are stopped)\n"
 	"  --max-passes N        refinement passes after the base pass (default 8)\n"
 	"  --jobs N              POV-Ray processes at once (default 4 per core: each\n"
 	"                        invocation waits 0.3 to 0.7 s on POV-Ray itself)\n"
@@ -99,7 +100,8 @@ static const char usage_options[] =
 	"  --final MODE          what OUT.exr holds per pixel: auto (default: the\n"
 	"                        samples' mean, or the regression's fit where the\n"
 	"                        pixel's noise is measured, like its neighbours', and\n"
-	"                        the fit is predicted at most half as far off), samples\n"
+	"                        the fit's squared error is predicted below half the\n"
+	"                        mean's), samples\n"
 	"                        (the mean of the pixel's samples), or reconstruction\n"
 	"                        (the fit everywhere); see the README\n"
 	"  -q, --quiet           no progress display\n"
@@ -590,6 +592,14 @@ static int radiosity_scale(const struct run *r)
 	return k;
 }
 
+/* What the radiosity pass at scale k should take, wall seconds. */
+static double radiosity_time(const struct run *r, int k)
+{
+	/* a whole-frame render waits for POV-Ray's exit: the latency and the
+	 * tail the region renders do not wait on */
+	return r->latency + r->tail + r->cost_sample * k * k * (double)r->w * r->h;
+}
+
 /*
  * The radiosity pass, after a base pass that found radiosity: the whole
  * frame at scale k on one thread, antialiasing off, saving its radiosity
@@ -598,13 +608,6 @@ static int radiosity_scale(const struct run *r)
  * or skipped (it would not end within the budget), -1 on failure,
  * POV_INTERRUPTED.
  */
-static double radiosity_time(const struct run *r, int k)
-{
-	/* a whole-frame render waits for POV-Ray's exit: the latency and the
-	 * tail the region renders do not wait on */
-	return r->latency + r->tail + r->cost_sample * k * k * (double)r->w * r->h;
-}
-
 static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, size_t errlen)
 {
 	/* under a budget, a solution on a smaller frame beats none: the region
@@ -722,8 +725,8 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	r->cost_sample = quantise(r->cost_sample, 1.0);
 	/* a region render repeats the setup (parse, bounding, writing its
 	 * frame): that is its cost.  It also waits on POV-Ray's latency, but
-	 * asleep, and a pass of at most --jobs regions (the planner's cap) waits
-	 * on it once whatever their number. */
+	 * asleep, and a pass whose regions all run at once (no more than
+	 * --jobs) waits on it once whatever their number. */
 	r->cost_job = setup > 0.01 ? quantise(setup, 1.0) : 0.01;
 	if (r->user_cost_job > 0.0)
 		r->cost_job = r->user_cost_job;
@@ -821,9 +824,12 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	if (r->budget > 0.0) {
 		double left = r->budget - elapsed(r);
 		/* in core-seconds, keeping a share for the analysis and the
-		 * latency of the pass's last round of jobs */
+		 * latency of the pass's last round of jobs; no pass when the
+		 * deadline its renders get (below) would not leave one render
+		 * its latency and setup */
 		pp.budget = (left - r->latency - 0.2) * r->cores * 0.8;
-		if (pp.budget <= 0.0) {
+		if (pp.budget <= 0.0 ||
+		    left - (r->passes[r->npasses - 1].analysis_s + 0.1) < r->latency + r->cost_job) {
 			r->stop = "budget spent";
 			return PASS_STOP;
 		}
@@ -1292,8 +1298,14 @@ bad:
 		if (rc == POV_INTERRUPTED) {
 			/* what finished is merged and saved: show it */
 			lpr_result_release(&res);
-			if (analyse(&r, &res, err, sizeof err) == 0)
+			double e_int;
+			if (analyse(&r, &res, err, sizeof err) == 0 &&
+			    plan_pixel_errors(&r.acc, res.error, res.fit, r.est, r.noise, &e_int, err,
+					      sizeof err) == 0) {
+				r.took = accum_final_choose(&r.acc, res.fit, res.error, res.leverage,
+							    r.noise, r.final, r.take, NULL);
 				write_output(&r, &res, NULL, err, sizeof err);
+			}
 			goto interrupted;
 		}
 		if (rc < 0)
@@ -1305,7 +1317,8 @@ bad:
 
 	/* the final image, error map and report.  The planner and the stop
 	 * went by the samples' errors; the error map and the estimate are the
-	 * final image's, the fit's predicted error where it takes the fit */
+	 * final image's: under --final auto, the fit's predicted error where it
+	 * takes the fit (under --final reconstruction, still the samples') */
 	long took = 0;
 	r.took = accum_final_choose(&r.acc, res.fit, res.error, res.leverage, r.noise, r.final,
 				    r.take, r.est);

@@ -363,7 +363,7 @@ median_row() {
 			be = ""
 			for (j = 1; j <= k; j++)
 				if (C[j] <= $4 && (be == "" || R[j] < be)) be = R[j]
-			m++; r[m] = be == "" ? 1e300 : $6 / be; row[m] = $0
+			m++; r[m] = be == "" || be <= 0 ? 1e300 : $6 / be; row[m] = $0
 		}
 		END {
 			for (a = 1; a <= m; a++) {
