@@ -927,12 +927,15 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		goto out;
 	struct pass_rec p = {0};
 	p.pass = pass;
+	int stopped = 0;
 	for (size_t k = 0; k < n; k++) {
 		const struct plan_region *g = &pl.regions[k];
 		int s = g->scale;
 		p.cpu_s += results[k].cpu_s;
 		p.invocations += results[k].attempts;
 		if (results[k].status != POV_OK) {
+			if (results[k].status == POV_CANCELLED && rc != POV_INTERRUPTED)
+				stopped++;	/* the budget's deadline */
 			if (results[k].status != POV_CANCELLED) {
 				p.failed++;
 				fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s%s%s\n",
@@ -955,6 +958,11 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		p.samples += s == ACC_AA ? 0.0 : (double)folded * s * s;
 		if (!r->keep)
 			unlink(outs[k]);
+	}
+	if (stopped) {
+		progress(r, "pass %d: %d of %zu region renders stopped at the budget's end, "
+			 "their samples lost", pass, stopped, n);
+		progress_end(r);
 	}
 	/* what a region render waits on besides its CPU, for the budget's
 	 * next passes: less than the base pass's latency, since the pool does

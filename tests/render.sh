@@ -333,6 +333,21 @@ for mode in crash hang; do
 	check "region job that $what: reported on stderr" grep -q "$( [ $mode = crash ] && echo crashed || echo 'timed out')" "$T/$mode.err"
 done
 
+# --- a budget is a deadline: a pass planned far over it is stopped in time ----
+# --cost-sample 1e-9: the planner thinks samples free and plans a pass that
+# would take many times the budget
+t0=$EPOCHREALTIME
+"$PP" render "$SC/media.pov" -o "$T/dl.exr" -W 80 -H 60 --budget 3 --target 1e-6 \
+	--cost-sample 1e-9 --workdir "$T/dl work" -v 2>"$T/dl.err"
+rc=$?
+dt=$(awk -v a="$t0" -v b="$EPOCHREALTIME" 'BEGIN { printf "%.2f", b - a }')
+check "budget deadline: a run whose pass is planned as free succeeds" test $rc -eq 0
+check "... its region renders are stopped at the budget's end" \
+	grep -q "stopped at the budget's end" "$T/dl.err"
+check "... and it ends within the 3 s budget ($dt s)" num 'a <= 3.3' "$dt"
+check "... the output is a complete image" valid_exr "$T/dl.exr"
+check "... no POV-Ray child left" no_povray_left "$T/dl work"
+
 # --- SIGINT: children stopped, output absent or valid, --resume finishes ----
 mkdir -p "$T/int"
 "$PP" render "$SC/glossy_reflection.pov" -o "$T/int/out.exr" -W 160 -H 120 --target 1e-5 \
