@@ -568,10 +568,10 @@ double accum_pixel_noise(const struct image *acc, size_t i, double diff)
 }
 
 double accum_pixel_error(const struct image *acc, size_t i, double press, const float fit[3],
-			 double diff)
+			 double noise)
 {
 	const float *o = acc->px + i * ACC_NCH;
-	double n = o[ACC_SAMPLES], e = accum_pixel_noise(acc, i, diff);
+	double n = o[ACC_SAMPLES], e = noise;
 	if (!(n >= 4.0)) {
 		/* no estimate (a hole the regression could not reach): assume
 		 * the worst a pixel of this brightness can plausibly be off by */
@@ -605,19 +605,25 @@ double accum_pixel_error(const struct image *acc, size_t i, double press, const 
  * 1.34, the fit within two of the mean's standard deviations).
  */
 #define ACC_FIT_ALIKE 4.0
+
+/* The variance of pixel o's mean: its sample variance over n, mean over
+ * R, G, B. */
+static double mean_variance(const float *o)
+{
+	return ((double)o[ACC_VAR_R] + o[ACC_VAR_G] + o[ACC_VAR_B]) / 3.0 / o[ACC_SAMPLES];
+}
+
 static int noise_alike(const struct image *acc, size_t i)
 {
-	const float *o = acc->px + i * ACC_NCH, *nb[8];
-	const double vi = ((double)o[ACC_VAR_R] + o[ACC_VAR_G] + o[ACC_VAR_B]) / o[ACC_SAMPLES];
+	const float *nb[8];
+	const double vi = mean_variance(acc->px + i * ACC_NCH);
 	const int nn = neighbours8(acc, i, nb);
 	double sl = 0.0;
 	int k = 0;
 	for (int j = 0; j < nn; j++) {
-		const float *q = nb[j];
-		if (!(q[ACC_SAMPLES] >= 2.0f))
+		if (!(nb[j][ACC_SAMPLES] >= 2.0f))
 			continue;
-		double vq = ((double)q[ACC_VAR_R] + q[ACC_VAR_G] + q[ACC_VAR_B]) / q[ACC_SAMPLES];
-		sl += log((vq + 1e-30) / (vi + 1e-30));
+		sl += log((mean_variance(nb[j]) + 1e-30) / (vi + 1e-30));
 		k++;
 	}
 	return k > 0 && isfinite(sl) && fabs(sl / k) <= log(ACC_FIT_ALIKE);
@@ -644,7 +650,7 @@ long accum_final_choose(const struct image *acc, const float *fit, const float *
 		else if (n >= 4.0 && isfinite(o[ACC_DIFF]) && isfinite(noise[i])) {
 			double h = leverage[i], p = press[i];
 			double sc = accum_error_scale(acc, i, NULL);
-			double v = ((double)o[ACC_VAR_R] + o[ACC_VAR_G] + o[ACC_VAR_B]) / 3.0 / n;
+			double v = mean_variance(o);
 			double u = noise[i] * sc < v ? noise[i] * sc : v;
 			if (isfinite(h) && isfinite(p) && h >= 0.0 && h <= 1.0 && u > 0.0) {
 				double bias = p - u > 0.0 ? p - u : 0.0;

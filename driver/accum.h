@@ -151,13 +151,21 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 double accum_error_scale(const struct image *acc, size_t i, const float fit[3]);
 
 /*
+ * The noise part of pixel i's estimated error (below): for a pixel of 4
+ * samples or more, diff (the 'diff' channel averaged over the pixel's
+ * neighbourhood, NaN when there is none; see plan_pixel_errors()) or,
+ * without one, its sample variance over n, relative to value^2 + 0.01 (of
+ * an estimate of the true value); NaN for fewer samples.
+ */
+double accum_pixel_noise(const struct image *acc, size_t i, double diff);
+
+/*
  * The estimated relative squared error of pixel i's mean (a term of
  * relMSE: squared error over value^2 + 0.01; 1 when unknown), the largest
  * of two estimates:
- * - noise: once the pixel has had a fold, diff, the 'diff' channel
- *   averaged over the pixel's neighbourhood (NaN when there is none; see
- *   plan_pixel_errors()); before that, the regression's error estimate press
- *   (mean over R, G, B of the squared error, NaN if none; fit is its R, G, B);
+ * - noise: once the pixel has 4 samples, noise, accum_pixel_noise();
+ *   before that, the regression's error estimate press (mean over R, G, B
+ *   of the squared error, NaN if none; fit is its R, G, B);
  * - edges: an edge between all the sample positions is invisible to both.
  *   Where a pixel differs from a neighbour by more than the two pixels'
  *   own samples spread over, the edge between them may lie in the strip
@@ -168,15 +176,7 @@ double accum_error_scale(const struct image *acc, size_t i, const float fit[3]);
  *   over its own darkness).
  */
 double accum_pixel_error(const struct image *acc, size_t i, double press, const float fit[3],
-			 double diff);
-
-/*
- * The noise part of that estimate: for a pixel of 4 samples or more,
- * diff (as for accum_pixel_error()) or, without one, its sample variance
- * over n, relative to value^2 + 0.01 (of an estimate of the true value);
- * NaN for fewer samples.
- */
-double accum_pixel_noise(const struct image *acc, size_t i, double diff);
+			 double noise);
 
 /* What the final image holds per pixel. */
 enum accum_final {
@@ -191,11 +191,11 @@ enum accum_final {
 
 /* The error a pixel that takes the fit is then estimated at: the fit's
  * predicted error, but at least this share of its samples' (of u, in
- * accum_final_choose()).  The
- * prediction is chosen for being small, and is so too small: 0.38 and 0.43
- * times the true error over the pixels that took the fit (media and
- * glossy_reflection at 160x120, target 1e-3, one run each), where those
- * pixels' true error fell 3 times from their samples' mean's (media). */
+ * accum_final_choose()).  The prediction is chosen for being small, and is
+ * so too small: 0.38 and 0.43 times the true error over the pixels that
+ * took the fit (media and glossy_reflection at 160x120, target 1e-3, one
+ * run each), where those pixels' true error fell 3 times from their
+ * samples' mean's (media). */
 #define ACC_FIT_FLOOR 0.25
 
 /*

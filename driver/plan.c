@@ -106,9 +106,10 @@ int plan_pixel_errors(const struct image *acc, const float *press, const float *
 		const float *o = acc->px + i * ACC_NCH;
 		double diff = isfinite(o[ACC_DIFF]) ?
 			diff_around(acc, mv, (int)(i % (size_t)acc->w), (int)(i / (size_t)acc->w)) : NAN;
-		e[i] = accum_pixel_error(acc, i, press[i], fit + 3 * i, diff);
+		double ns = accum_pixel_noise(acc, i, diff);
+		e[i] = accum_pixel_error(acc, i, press[i], fit + 3 * i, ns);
 		if (noise)
-			noise[i] = accum_pixel_noise(acc, i, diff);
+			noise[i] = ns;
 		sum += e[i];
 	}
 	free(mv);
@@ -782,8 +783,8 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 		out->nregions = 0;
 	}
 
-	/* over the budget: the least worth goes; over the cap or still over
-	 * the budget: the regions worth least per cost */
+	/* over the budget: the least worth goes (fit_budget() leaves at most
+	 * the budget); over the cap: the regions worth least per cost */
 	if (fit_budget(p, out, ps, gain)) {
 		errbuf_printf(err, errlen, "out of memory packing regions");
 		goto out;
@@ -791,16 +792,6 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	qsort(out->regions, out->nregions, sizeof(*out->regions), by_value);
 	while (out->nregions > (size_t)p->max_regions)
 		out->nregions--;
-	if (p->budget > 0.0) {
-		double c = 0.0;
-		size_t k = 0;
-		for (; k < out->nregions; k++) {
-			if (c + out->regions[k].cost > p->budget)
-				break;
-			c += out->regions[k].cost;
-		}
-		out->nregions = k;
-	}
 	if (!out->nregions) {
 		out->outcome = PLAN_NO_BUDGET;
 		ret = 0;

@@ -1471,8 +1471,9 @@ struct pool {
 	size_t n;
 	size_t next;		/* no pending job before this index */
 	size_t running, done;
-	int stopping;		/* a signal arrived: start nothing, stop all */
-	int past;		/* past opts->deadline_s: start nothing, stop all */
+	int stopping;		/* STOP_NONE, or why the pool starts nothing and
+				 * stops all: STOP_CANCEL (a signal arrived) or
+				 * STOP_DEADLINE (opts->deadline_s passed) */
 	int devnull;
 	double t0;
 	int ino;		/* inotify descriptor when opts->ready, or -1 */
@@ -1540,6 +1541,16 @@ static void pool_early(struct pool *p)
 	}
 }
 
+/* Start nothing more and stop the running jobs (why: STOP_CANCEL or
+ * STOP_DEADLINE), SIGKILL after grace seconds. */
+static void pool_stop(struct pool *p, int why, double grace)
+{
+	p->stopping = why;
+	for (size_t i = 0; i < p->n; i++)
+		if (p->pj[i].state == J_RUNNING)
+			stop_job(&p->pj[i], why, now_s(), grace);
+}
+
 static void job_final(struct pool *p, size_t i)
 {
 	p->pj[i].state = J_DONE;
@@ -1551,7 +1562,7 @@ static void job_final(struct pool *p, size_t i)
 /* Start pending jobs while there are free slots. */
 static void pool_fill(struct pool *p)
 {
-	while (!p->stopping && !p->past && p->running < (size_t)p->opts->max_jobs) {
+	while (!p->stopping && p->running < (size_t)p->opts->max_jobs) {
 		struct pjob *j;
 
 		while (p->next < p->n && p->pj[p->next].state != J_PENDING)
@@ -1594,7 +1605,7 @@ static void pool_wait(struct pool *p)
 		if (j->kill_at && !j->killed && j->kill_at - now < wait_s)
 			wait_s = j->kill_at - now;
 	}
-	if (p->opts->deadline_s > 0 && !p->past && p->t0 + p->opts->deadline_s - now < wait_s)
+	if (p->opts->deadline_s > 0 && !p->stopping && p->t0 + p->opts->deadline_s - now < wait_s)
 		wait_s = p->t0 + p->opts->deadline_s - now;
 	if (eof_seen && wait_s > 0.005)
 		wait_s = 0.005;	/* its output is closed: the exit is imminent */
@@ -1636,7 +1647,7 @@ static void pool_check(struct pool *p)
 		if (waitid(P_PID, (id_t)j->pid, &si, WEXITED | WNOHANG | WNOWAIT) == 0 &&
 		    si.si_pid == j->pid) {
 			p->running--;
-			if (finish(j, p->opts, p->t0, &p->res[i], p->stopping || p->past)) {
+			if (finish(j, p->opts, p->t0, &p->res[i], p->stopping)) {
 				j->state = J_PENDING;	/* retry */
 				if (i < p->next)
 					p->next = i;
@@ -1733,25 +1744,18 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 
 	p.t0 = now_s();
 	while (1) {
-		if (!p.stopping && pov_signal_received()) {
-			p.stopping = 1;
-			for (size_t i = 0; i < njobs; i++)
-				if (p.pj[i].state == J_RUNNING)
-					stop_job(&p.pj[i], STOP_CANCEL, now_s(), opts->grace_s);
-		}
-		if (!p.past && opts->deadline_s > 0 && now_s() - p.t0 >= opts->deadline_s) {
+		if (p.stopping != STOP_CANCEL && pov_signal_received())
+			pool_stop(&p, STOP_CANCEL, opts->grace_s);
+		if (!p.stopping && opts->deadline_s > 0 && now_s() - p.t0 >= opts->deadline_s) {
 			/* outputs closed just before it still count */
 			if (p.ino >= 0) {
 				pool_notice(&p);
 				pool_early(&p);
 			}
-			p.past = 1;
-			for (size_t i = 0; i < njobs; i++)
-				if (p.pj[i].state == J_RUNNING)
-					stop_job(&p.pj[i], STOP_DEADLINE, now_s(), 0.05);
+			pool_stop(&p, STOP_DEADLINE, 0.05);
 		}
 		pool_fill(&p);
-		if (!p.running && (p.stopping || p.past || p.done == njobs))
+		if (!p.running && (p.stopping || p.done == njobs))
 			break;
 		pool_wait(&p);
 		pool_check(&p);
@@ -1764,7 +1768,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 		if (results[i].attempts == 0) {
 			int sig = pov_signal_received();
 
-			if (p.stopping)
+			if (p.stopping == STOP_CANCEL)
 				report(&results[i], POV_CANCELLED, "not started: interrupted by %s",
 				       sig ? signame(sig) : "a signal");
 			else
@@ -1774,7 +1778,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 		}
 		job_final(&p, i);
 	}
-	rc = p.stopping ? POV_INTERRUPTED : 0;
+	rc = p.stopping == STOP_CANCEL ? POV_INTERRUPTED : 0;
 out:
 	if (chld_changed)
 		sigaction(SIGCHLD, &chld_old, NULL);

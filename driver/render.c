@@ -385,6 +385,19 @@ static int stats_printed(void *arg, size_t index, const char *log)
 	return pov_render_time_printed(log);
 }
 
+/* The pixels' errors (r->est, r->noise, the image's estimate in *est) from
+ * the analysis res of r->acc, and which pixels the image written takes
+ * from the fit. */
+static int estimate(struct run *r, const struct lpr_result *res, double *est, char *err,
+		    size_t errlen)
+{
+	if (plan_pixel_errors(&r->acc, res->error, res->fit, r->est, r->noise, est, err, errlen))
+		return -1;
+	r->took = accum_final_choose(&r->acc, res->fit, res->error, res->leverage, r->noise,
+				     r->final, r->take, NULL);
+	return 0;
+}
+
 /* The analysis the planner and the final image use. */
 static int analyse(struct run *r, struct lpr_result *res, char *err, size_t errlen)
 {
@@ -410,16 +423,13 @@ static int analyse(struct run *r, struct lpr_result *res, char *err, size_t errl
 	return rc;
 }
 
-static int write_output(struct run *r, const struct lpr_result *res, long *took, char *err,
-			size_t errlen)
+static int write_output(struct run *r, const struct lpr_result *res, char *err, size_t errlen)
 {
 	static const char *const rgb_names[3] = { "R", "G", "B" };
 	struct image out = {0};
 	if (image_init(&out, r->w, r->h, 3, rgb_names, err, errlen))
 		return -1;
 	accum_final_image(&r->acc, res->fit, r->take, out.px);
-	if (took)
-		*took = r->took;
 	int rc = image_write_exr(r->out, &out, err, errlen);
 	image_release(&out);
 	return rc;
@@ -821,23 +831,23 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	pp.cost_sample = r->cost_sample;
 	pp.max_regions = r->jobs > 8 ? r->jobs : 8;
 	pp.grid = r->grid;
+	/* what a pass keeps of the budget after its renders: the time of the
+	 * last analysis and 0.1 s; its renders' deadline is the rest */
+	const double reserve = r->passes[r->npasses - 1].analysis_s + 0.1;
 	if (r->budget > 0.0) {
 		double left = r->budget - elapsed(r);
 		/* in core-seconds, keeping a share for the analysis and the
 		 * latency of the pass's last round of jobs; no pass when the
-		 * deadline its renders get (below) would not leave one render
-		 * its latency and setup */
+		 * deadline would not leave one render its latency and setup */
 		pp.budget = (left - r->latency - 0.2) * r->cores * 0.8;
-		if (pp.budget <= 0.0 ||
-		    left - (r->passes[r->npasses - 1].analysis_s + 0.1) < r->latency + r->cost_job) {
+		if (pp.budget <= 0.0 || left - reserve < r->latency + r->cost_job) {
 			r->stop = "budget spent";
 			return PASS_STOP;
 		}
 		/* the passes that still fit, each waiting on POV-Ray's latency
 		 * and the analysis: when only one or two do, this pass takes
 		 * its share of the budget even past the pixels' next scales */
-		double over = r->latency + r->passes[r->npasses - 1].analysis_s + 0.1;
-		int fit = (int)((left - 0.2) / over);
+		int fit = (int)((left - 0.2) / (r->latency + reserve));
 		if (fit <= 2)
 			pp.fill = fit <= 1 ? pp.budget : pp.budget / fit;
 	}
@@ -906,7 +916,6 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		 * average: glossy_reflection at --budget 8 ended at 10.9 s):
 		 * regions still rendering when only the analysis's time is
 		 * left are stopped, and what they did is lost */
-		double reserve = r->passes[r->npasses - 1].analysis_s + 0.1;
 		po.deadline_s = r->budget - elapsed(r) - reserve;
 		if (po.deadline_s < 0.01)
 			po.deadline_s = 0.01;
@@ -1271,12 +1280,8 @@ bad:
 			goto fail;
 		size_t npx = (size_t)r.w * r.h;
 		double est;
-		if (plan_pixel_errors(&r.acc, res.error, res.fit, r.est, r.noise, &est, err,
-				      sizeof err))
+		if (estimate(&r, &res, &est, err, sizeof err))
 			goto fail;
-		/* which pixels the image written takes from the fit */
-		r.took = accum_final_choose(&r.acc, res.fit, res.error, res.leverage, r.noise,
-					    r.final, r.take, NULL);
 		long left = 0;
 		for (size_t k = 0; k < npx; k++)
 			left += r.est[k] > r.target;
@@ -1285,7 +1290,7 @@ bad:
 		last->analysis_s = now_s() - ta;
 		last->wall_s += last->analysis_s;
 		if (save_progress(&r, err, sizeof err) ||
-		    write_output(&r, &res, NULL, err, sizeof err))
+		    write_output(&r, &res, err, sizeof err))
 			goto fail;
 		double el = elapsed(&r);
 		if (r.budget > 0.0)
@@ -1308,12 +1313,8 @@ bad:
 			lpr_result_release(&res);
 			double e_int;
 			if (analyse(&r, &res, err, sizeof err) == 0 &&
-			    plan_pixel_errors(&r.acc, res.error, res.fit, r.est, r.noise, &e_int, err,
-					      sizeof err) == 0) {
-				r.took = accum_final_choose(&r.acc, res.fit, res.error, res.leverage,
-							    r.noise, r.final, r.take, NULL);
-				write_output(&r, &res, NULL, err, sizeof err);
-			}
+			    estimate(&r, &res, &e_int, err, sizeof err) == 0)
+				write_output(&r, &res, err, sizeof err);
 			goto interrupted;
 		}
 		if (rc < 0)
@@ -1327,14 +1328,13 @@ bad:
 	 * went by the samples' errors; the error map and the estimate are the
 	 * final image's: under --final auto, the fit's predicted error where it
 	 * takes the fit (under --final reconstruction, still the samples') */
-	long took = 0;
 	r.took = accum_final_choose(&r.acc, res.fit, res.error, res.leverage, r.noise, r.final,
 				    r.take, r.est);
 	double est = 0.0;
 	for (size_t k = 0; k < (size_t)r.w * r.h; k++)
 		est += r.est[k];
 	est /= (double)r.w * r.h;
-	if (write_output(&r, &res, &took, err, sizeof err) ||
+	if (write_output(&r, &res, err, sizeof err) ||
 	    write_error_map(&r, &res, err, sizeof err))
 		goto fail;
 	if (r.report && write_report(&r, est, err, sizeof err))
@@ -1347,7 +1347,7 @@ bad:
 			"%.1f s, %.1f CPU s; wrote %s", r.stop, r.npasses - 1, est, elapsed(&r), cpu,
 			r.out);
 		if (r.final == ACC_FINAL_AUTO)
-			fprintf(stderr, " (%ld of %d pixels from the fit)", took, r.w * r.h);
+			fprintf(stderr, " (%ld of %d pixels from the fit)", r.took, r.w * r.h);
 		fputc('\n', stderr);
 	}
 	if (!r.keep && !r.user_workdir) {

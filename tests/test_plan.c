@@ -1096,19 +1096,19 @@ static void test_pixel_errors(void **state)
 	}
 	float dfit[3] = { 0.01f, 0.01f, 0.01f };
 	/* the smoothed PRESS of the lamp's residual, relative to 0.01^2 + 0.01 */
-	got = accum_pixel_error(&acc, 1, 3.3, dfit, NAN);
+	got = accum_pixel_error(&acc, 1, 3.3, dfit, accum_pixel_noise(&acc, 1, NAN));
 	double dh = 26.0 - 0.01, bound = dh * dh / (26.0 * 26.0 + 0.01);
 	assert_close(got, bound, 1e-5, 0.0, "dark pixel beside a lamp");
 	assert_true(got < 1.0);
 	/* the lamp itself: its range reaches down to 0.01, so PRESS stands */
 	float lfit[3] = { 20.0f, 20.0f, 20.0f };
-	got = accum_pixel_error(&acc, 2, 3.3, lfit, NAN);
+	got = accum_pixel_error(&acc, 2, 3.3, lfit, accum_pixel_noise(&acc, 2, NAN));
 	assert_close(got, 3.3 / (20.0 * 20.0 + 0.01), 1e-5, 0.0, "the lamp");
 	/* a flat neighbourhood: nothing to be off by */
 	for (int x = 0; x < 3; x++)
 		for (int c = 0; c < 3; c++)
 			accpx(&acc, (size_t)x)[c] = 0.5f;
-	assert_true(accum_pixel_error(&acc, 1, 0.01, fit, NAN) == 0.0);
+	assert_true(accum_pixel_error(&acc, 1, 0.01, fit, accum_pixel_noise(&acc, 1, NAN)) == 0.0);
 	image_release(&acc);
 
 	/* a firefly: 5 samples of which one bright lifts the mean to 0.83;
@@ -1118,16 +1118,16 @@ static void test_pixel_errors(void **state)
 	for (int c = 0; c < 3; c++)
 		o[c] = 0.83f;
 	set_px(&acc, 0, 0, 5.0f, 2.18f, 0.05f);
-	got = accum_pixel_error(&acc, 0, 1e-6, fit, 0.05);
+	got = accum_pixel_error(&acc, 0, 1e-6, fit, accum_pixel_noise(&acc, 0, 0.05));
 	assert_close(got, 0.05 * want_bias(o), 1e-6, 0.0, "firefly");
 	assert_true(got > 2.5 * 0.05 && got < 2.8 * 0.05);
 	/* its true value estimated below a quarter of m^2: the floor */
 	set_px(&acc, 0, 0, 5.0f, 5.0f, 0.05f);
-	got = accum_pixel_error(&acc, 0, 1e-6, fit, 0.05);
+	got = accum_pixel_error(&acc, 0, 1e-6, fit, accum_pixel_noise(&acc, 0, 0.05));
 	assert_close(got, 0.05 * (3 * (0.83 * 0.83 + 0.01)) / (3 * (0.25 * 0.83 * 0.83 + 0.01)),
 		     1e-5, 0.0, "firefly at the floor");
 	/* the variance of the mean, where there is no fold difference */
-	got = accum_pixel_error(&acc, 0, 1e-6, fit, NAN);
+	got = accum_pixel_error(&acc, 0, 1e-6, fit, accum_pixel_noise(&acc, 0, NAN));
 	assert_close(got, 5.0 / 5.0 / (0.83 * 0.83 + 0.01) * want_bias(o), 1e-5, 0.0,
 		     "variance of the mean");
 	image_release(&acc);

@@ -656,7 +656,8 @@ static void test_shell_line_renders(void **state)
 
 /* ---- statistics ----------------------------------------------------------- */
 
-static void parse_fixture(const char *name, struct pov_stats *st, int want_rc)
+/* The text of fixture DATA NAME (the caller frees it). */
+static char *fixture(const char *name)
 {
 	char path[256];
 	char *text;
@@ -665,6 +666,13 @@ static void parse_fixture(const char *name, struct pov_stats *st, int want_rc)
 	text = read_file(path);
 	if (!text)
 		fail_msg("cannot read fixture '%s'", path);
+	return text;
+}
+
+static void parse_fixture(const char *name, struct pov_stats *st, int want_rc)
+{
+	char *text = fixture(name);
+
 	assert_int_equal(pov_stats_parse(text, st), want_rc);
 	free(text);
 }
@@ -672,13 +680,10 @@ static void parse_fixture(const char *name, struct pov_stats *st, int want_rc)
 /* The render time printed, through the trace's CPU line, without radiosity. */
 static void test_render_time_printed(void **state)
 {
-	char path[256];
 	char *text, *cut;
 
 	(void)state;
-	snprintf(path, sizeof(path), DATA "noaa.txt");
-	text = read_file(path);
-	assert_non_null(text);
+	text = fixture("noaa.txt");
 	assert_true(pov_render_time_printed(text));
 	/* up to the trace time's CPU line, without its end: not yet */
 	cut = strstr(strstr(text, "Trace Time:"), "CPU-seconds total");
@@ -688,14 +693,10 @@ static void test_render_time_printed(void **state)
 	*strstr(text, "Render Time:") = '\0';
 	assert_false(pov_render_time_printed(text));
 	free(text);
-	snprintf(path, sizeof(path), DATA "radiosity.txt");
-	text = read_file(path);
-	assert_non_null(text);
+	text = fixture("radiosity.txt");
 	assert_false(pov_render_time_printed(text));
 	free(text);
-	snprintf(path, sizeof(path), DATA "photons.txt");
-	text = read_file(path);
-	assert_non_null(text);
+	text = fixture("photons.txt");
 	assert_true(pov_render_time_printed(text));
 	free(text);
 }
