@@ -219,18 +219,23 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			/* the render's samples spread as the pixel's do; no pixel
 			 * takes it as more than its own a / d (a bias where the
 			 * pixel's spread is small would be weighted as the region's
-			 * noisier pixels prove it worth), and a pixel with no
-			 * spread to weigh it by takes it as one sample */
+			 * noisier pixels prove it worth).  A pixel with no spread
+			 * to weigh it by (the base pass's one sample) takes it as
+			 * ACC_AA_FIRST samples, in place of scale 2 */
 			struct accum_worth one = {0};
 			worth_add(acc, i, ACC_AA, mean, &one);
 			double own = worth_samples(&one);
-			int k = own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
+			const int first = !(o[ACC_SAMPLES] >= 2.0f) && !accum_has_scale(acc, i, 2);
+			int k = first ? ACC_AA_FIRST : own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
 			for (int c = 0; c < 3; c++)
-				m2[c] = k > 1 ? (double)o[ACC_VAR_R + c] * (k - 1) : 0.0;
+				m2[c] = k > 1 && !first ? (double)o[ACC_VAR_R + c] * (k - 1) : 0.0;
 			double na = o[ACC_SAMPLES], prev = o[ACC_DIFF];
 			if (accum_fold(acc, i, ACC_AA, k, mean, m2, pass))
 				continue;
 			count++;
+			if (first)
+				acc->px[i * ACC_NCH + ACC_SCALES] =
+					(float)(scale_mask(acc, i) | 1u << 2);
 			if (!(na > 0.0))
 				continue;
 			/* the error of the new mean, not knowing which of the two

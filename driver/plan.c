@@ -875,7 +875,7 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 	if (r->scale == ACC_AA) {
 		/* POV-Ray's own adaptive antialiasing, jittered (accum.h) */
 		extra[job->nextra++] = "+AM2";
-		extra[job->nextra++] = "+A0.0";
+		extra[job->nextra++] = r->aa_first ? "+A0.1" : "+A0.0";
 		extra[job->nextra++] = "+R4";
 		extra[job->nextra++] = "+J";
 	} else if (grid) {

@@ -83,6 +83,9 @@ struct plan_region {
 	int frame;		/* the render's size over the image's: 0 for
 				 * accum_render_factor(scale), or
 				 * ACC_GRID_FRAME for a grid render */
+	int aa_first;		/* with scale ACC_AA: the render takes scale 2's
+				 * place, at POV-Ray's threshold 0.1 rather than
+				 * 0 (render.c, choose_samplers()) */
 };
 
 enum plan_outcome {
@@ -134,8 +137,9 @@ void plan_release(struct plan *pl);
  * The POV-Ray job for region r of a plan, rendering into output: the
  * region at r->scale times base with antialiasing off; for a grid render
  * (r->frame ACC_GRID_FRAME) at twice base with +AM1 +A0.0 +R(scale/2)
- * +J0.5; when r->scale is ACC_AA at scale 1 with POV-Ray's antialiasing
- * (the options appended after the user's, which come from base->extra).
+ * +J0.5; when r->scale is ACC_AA at scale 1 with POV-Ray's antialiasing,
+ * +AM2 +A0.0 +R4 +J, or +A0.1 for r->aa_first (the options appended after
+ * the user's, which come from base->extra).
  * base gives the scene,
  * full size, threads, defines, extra options, work directory and binary;
  * the job borrows region (storage for the scaled rectangle) and extra
