@@ -86,17 +86,22 @@ static const char usage_options[] =
 	"  --report FILE         JSON report of every pass (default: none)\n"
 	"  --sampler S           how pixels get their samples: auto (default: grid for\n"
 	"                        the scales whose scaled frame would exceed 1 Mpixel,\n"
-	"                        scale below), grid (scales 4, 8 and 16 as renders at\n"
-	"                        twice the size with POV-Ray's +AM1 +A0.0 +R(scale/2)\n"
-	"                        +J0.5: scale x scale jittered samples), scale\n"
-	"                        (resolution scaling throughout: the render is scale\n"
-	"                        times the size, which POV-Ray pays for per render\n"
-	"                        whatever the region), aa (scaling, and for pixels\n"
-	"                        with 21+ samples first, once per pixel, POV-Ray's\n"
-	"                        antialiasing, +AM2 +A0 +R4 +J, weighted by what it\n"
-	"                        proves worth), or jitter (no scale-2 pass: scales 4, 8\n"
-	"                        and 16 as grid renders, so every sample added to the\n"
-	"                        base pass is jittered); see the README\n"
+	"                        scale below; and where the estimated error sits in a\n"
+	"                        few pixels, 0.1% of them holding half of it, as at\n"
+	"                        highlights, scale 2 as one render at scale 1 with\n"
+	"                        POV-Ray's +AM2 +A0.1 +R4 +J), grid (scales 4, 8 and\n"
+	"                        16 as renders at twice the size with POV-Ray's +AM1\n"
+	"                        +A0.0 +R(scale/2) +J0.5: scale x scale jittered\n"
+	"                        samples), scale (resolution scaling throughout: the\n";
+static const char usage_options2[] =
+	"                        render is scale times the size, which POV-Ray pays\n"
+	"                        for per render whatever the region), aa (scaling,\n"
+	"                        and for pixels with 21+ samples first, once per\n"
+	"                        pixel, POV-Ray's antialiasing, +AM2 +A0 +R4 +J,\n"
+	"                        weighted by what it proves worth), or jitter (no\n"
+	"                        scale-2 pass: scales 4, 8 and 16 as grid renders, so\n"
+	"                        every sample added to the base pass is jittered); see\n"
+	"                        the README\n"
 	"  --final MODE          what OUT.exr holds per pixel: auto (default: the\n"
 	"                        samples' mean, or the regression's fit where the\n"
 	"                        pixel's noise is measured, like its neighbours', and\n"
@@ -183,6 +188,7 @@ static void print_usage(FILE *f)
 {
 	fputs(usage, f);
 	fputs(usage_options, f);
+	fputs(usage_options2, f);
 }
 
 static void progress(struct run *r, const char *fmt, ...)

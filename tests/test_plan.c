@@ -571,6 +571,7 @@ static void test_merge_aa(void **state)
 		capped += k[i] < pool;
 	}
 	assert_true(capped >= 1 && capped <= 3);
+	accpx(&acc, 7)[ACC_SCALES] = (float)(1u << 1 | 1u << 2);
 	float before[8][ACC_NCH];
 	for (int i = 0; i < 8; i++)
 		memcpy(before[i], accpx(&acc, (size_t)i), sizeof(before[i]));
@@ -601,11 +602,17 @@ static void test_merge_aa(void **state)
 		assert_close(o[ACC_DIFF], want, 1e-5, 0.0, "difference over the weights");
 	}
 	/* a pixel with one sample has no spread to weigh the render by: the
-	 * render counts as one sample */
+	 * render takes scale 2's place as ACC_AA_FIRST samples (pixel 7 has
+	 * had scale 2: there it counts as one sample) */
 	for (int i = 4; i < 8; i++) {
 		const float *o = accpx(&acc, (size_t)i);
-		assert_true(o[ACC_SAMPLES] == 2.0f);
-		assert_close(o[0], (before[i][0] + r.px[i * 3]) / 2.0, 1e-6, 0.0, "two samples");
+		const int n = i == 7 ? 1 : ACC_AA_FIRST;
+		assert_true(o[ACC_SAMPLES] == (float)(1 + n));
+		assert_close(o[0], (before[i][0] + n * (double)r.px[i * 3]) / (1 + n), 1e-6, 0.0,
+			     "the base sample and the render");
+		assert_true(accum_has_scale(&acc, (size_t)i, 2));
+		assert_true(accum_has_scale(&acc, (size_t)i, ACC_AA));
+		assert_true(accum_next_scale(&acc, (size_t)i) == 4);
 	}
 	/* once per pixel: the same render again changes nothing */
 	float after[ACC_NCH];
@@ -1247,9 +1254,9 @@ static void test_final_choice(void **state)
 static void test_regions_file(void **state)
 {
 	struct plan_region rs[3] = {
-		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1, 0 },
-		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2, 0 },
-		{ 63, 47, 63, 47, 16, 1, 0.1, 0.3, 0 },
+		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1, 0, 0 },
+		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2, 0, 0 },
+		{ 63, 47, 63, 47, 16, 1, 0.1, 0.3, 0, 0 },
 	};
 	static char o0[] = "r0.exr", o1[] = "a dir/with spaces/region 1.exr",
 		o2[] = "/tmp/x y  z.exr";
@@ -1323,12 +1330,12 @@ static void assert_job_frame(const struct pov_job *job, const struct pov_region 
 
 /* The antialiasing options a region job appends after the user's two:
  * method, threshold 0, depth, jitter. */
-static void assert_aa_options(const struct pov_job *job, const char *method, const char *depth,
-			      const char *jitter)
+static void assert_aa_options(const struct pov_job *job, const char *method,
+			      const char *threshold, const char *depth, const char *jitter)
 {
 	assert_int_equal(job->nextra, 6);
 	assert_string_equal(job->extra[2], method);
-	assert_string_equal(job->extra[3], "+A0.0");
+	assert_string_equal(job->extra[3], threshold);
 	assert_string_equal(job->extra[4], depth);
 	assert_string_equal(job->extra[5], jitter);
 }
@@ -1337,7 +1344,7 @@ static void test_plan_job(void **state)
 {
 	static const char *const base_extra[] = { "+Q9", "Antialias_Threshold=0.1" };
 	struct pov_job base, job;
-	struct plan_region r = { 3, 2, 10, 7, 4, 0, 0.0, 0.0, 0 };
+	struct plan_region r = { 3, 2, 10, 7, 4, 0, 0.0, 0.0, 0, 0 };
 	struct pov_region region;
 	const char *extra[3];
 
@@ -1371,7 +1378,13 @@ static void test_plan_job(void **state)
 	assert_int_equal(region.x0, 3);
 	assert_int_equal(region.y1, 7);
 	assert_string_equal(job.extra[1], "Antialias_Threshold=0.1");
-	assert_aa_options(&job, "+AM2", "+R4", "+J");
+	assert_aa_options(&job, "+AM2", "+A0.0", "+R4", "+J");
+	/* in scale 2's place: threshold 0.1 */
+	r.aa_first = 1;
+	plan_job(&base, &r, "out/a1.exr", &region, aextra, &job);
+	assert_int_equal(job.width, 64);
+	assert_aa_options(&job, "+AM2", "+A0.1", "+R4", "+J");
+	r.aa_first = 0;
 	char name[64];
 	plan_output_name(name, sizeof(name), "w", 3, 7, ACC_AA);
 	assert_string_equal(name, "w/p03-r007-aa.exr");
@@ -1385,7 +1398,7 @@ static void test_plan_job(void **state)
 		r.frame = ACC_GRID_FRAME;
 		plan_job(&base, &r, "out/g.exr", &region, aextra, &job);
 		assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
-		assert_aa_options(&job, "+AM1", s == 4 ? "+R2" : s == 8 ? "+R4" : "+R8", "+J0.5");
+		assert_aa_options(&job, "+AM1", "+A0.0", s == 4 ? "+R2" : s == 8 ? "+R4" : "+R8", "+J0.5");
 		assert_int_equal(accum_grid_samples(s), s * s + 4);
 	}
 	/* which scales are grid renders */
