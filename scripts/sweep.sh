@@ -560,7 +560,7 @@ summarize() {
 			print line "\t" bo "\t" bc "\t" bset "\t" s1[sc] "\t" sm[sc] "\t" \
 				med "\t" bh
 		}
-	}' "$CSV"
+	}' "$CSV" "$rep"
 }
 
 g3() { awk -v x="$1" 'BEGIN { if (x == "-" || x == "") print "-"; else printf "%.3g", x }'; }
@@ -667,12 +667,36 @@ done < <(summarize)
 # run that cost no more CPU (the lower envelope at that time) and the ratio
 # of relMSEs; the cheapest POV-Ray run that reached povpress's relMSE and the
 # speed-up (its CPU over povpress's); the error estimate's fidelity.
+# With repeats.csv, the ratio cell also gives the range of the ratios of all
+# the setting's runs, each against the envelope at its own CPU: a run whose
+# CPU falls either side of a POV-Ray setting's cost can swing 2x on the same
+# image.
 pp_table() {
+	local rep=/dev/null
+	((REPEAT > 1)) && [[ -s $RCSV ]] && rep=$RCSV
 	awk -F, '
-	NR > 1 && $2 != "povpress" { n = ++cnt[$1]; C[$1, n] = $4; R[$1, n] = $6; S[$1, n] = $2 " " $3 }
-	NR > 1 && $2 == "povpress" { pp[++np] = $0 }
+	FNR == 1 { file++ }
+	file == 1 && FNR > 1 && $2 != "povpress" { n = ++cnt[$1]; C[$1, n] = $4; R[$1, n] = $6; S[$1, n] = $2 " " $3 }
+	file == 1 && FNR > 1 && $2 == "povpress" { pp[++np] = $0 }
+	file == 2 && FNR > 1 && $2 == "povpress" { rp[++nr] = $0 }
 	function g(x) { return sprintf("%.3g", x) }
+	function envelope(sc, c,   j, b) {
+		b = ""
+		for (j = 1; j <= cnt[sc]; j++)
+			if (C[sc, j] <= c && (b == "" || R[sc, j] < b))
+				b = R[sc, j]
+		return b
+	}
 	END {
+		for (k = 1; k <= nr; k++) {
+			split(rp[k], f, ",")
+			be = envelope(f[1], f[4])
+			if (be == "")
+				continue
+			key = f[1] SUBSEP f[3]; q = f[6] / be
+			if (!(key in lo) || q < lo[key]) lo[key] = q
+			if (!(key in hi) || q > hi[key]) hi[key] = q
+		}
 		for (k = 1; k <= np; k++) {
 			split(pp[k], f, ",")
 			sc = f[1]; c = f[4]; r = f[6]
@@ -682,13 +706,15 @@ pp_table() {
 				if (R[sc, j] <= r && (fe == "" || C[sc, j] < fe)) { fe = C[sc, j]; fs = S[sc, j] }
 			}
 			ratio = be == "" ? "-" : sprintf("%.2f", r / be)
+			if (be != "" && (sc SUBSEP f[3]) in lo)
+				ratio = ratio sprintf(" (%.2f-%.2f)", lo[sc, f[3]], hi[sc, f[3]])
 			speed = fe == "" ? "none reaches it" : sprintf("%.2fx (%s s, %s)", fe / c, fe, fs)
 			fid = f[8] == "" ? "-" : sprintf("%.2f / %.2f (%.0f%%)", f[9], f[10], 100 * f[9] / f[10])
 			est = f[8] == "" ? "-" : sprintf("%.2f", f[8] / r)
 			printf "| %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s |\n", sc, f[3], c, f[5],
 				g(r), be == "" ? "-" : g(be), bs, ratio, speed, est, fid
 		}
-	}' "$CSV"
+	}' "$CSV" "$rep"
 }
 
 echo
@@ -710,7 +736,8 @@ echo "$PPT" | awk -F'|' '{ printf "%-18s %-14s cpu %6s  relMSE %-9s POV-Ray %-22
 	echo "the 20% of pixels its error map ranks highest, next to an oracle's share."
 	if ((REPEAT > 1)); then
 		echo "Each setting ran $REPEAT times; the row is the run with the median ratio"
-		echo "(every run is in repeats.csv)."
+		echo "(every run is in repeats.csv), and the ratio cell gives in parentheses the"
+		echo "lowest and highest of the runs' ratios, each at its own CPU."
 	fi
 	echo
 	echo "| scene | run | CPU s | wall s | relMSE | POV-Ray at equal CPU | ratio | equal-error speed-up | est/true | capture20 / oracle |"

@@ -233,6 +233,22 @@ m=$(median_row A A,povpress,t,0.05,1,0.001,,,, A,povpress,t,0.5,1,0.02,,,, \
 	A,povpress,t,0.5,1,0.01,,,,)
 check "sweep: a run cheaper than every POV-Ray run ranks last" \
 	test "$m" = A,povpress,t,0.5,1,0.02,,,,
+# pp_table: the table row of the median run, its ratio's range over all runs
+eval "$(sed -n '/^pp_table() {/,/^}/p' "$ROOT/scripts/sweep.sh")"
+CSV=$T/pp.csv RCSV=$T/pp-rep.csv REPEAT=3
+printf '%s\n' scene,method,setting,cpu_s,wall_s,relmse,psnr,est,cap,orc \
+	A,noaa,-,0.1,1,0.01,,,, A,am2,x,1.0,1,0.001,,,, A,povpress,t,1.5,1,0.002,0.001,0.5,0.9 \
+	>"$CSV"
+printf '%s\n' scene,method,setting,cpu_s,wall_s,relmse,psnr,est,cap,orc \
+	A,povpress,t,0.5,1,0.004,,,, A,povpress,t,1.5,1,0.002,,,, A,povpress,t,0.2,1,0.03,,,, \
+	>"$RCSV"
+row=$(pp_table)
+check "sweep: the table's ratio, and the range over the runs (0.40-3.00)" \
+	grep -qF "| 2.00 (0.40-3.00) |" <<<"$row"
+check "sweep: ... the envelope at the row's CPU and its setting" \
+	grep -qF "| 0.001 (am2 x) |" <<<"$row"
+REPEAT=1
+check "sweep: one run per setting: no range" grep -qF "| 2.00 |" <<<"$(pp_table)"
 "$ROOT/scripts/sweep.sh" --repeat 0 >"$T/rep.out" 2>&1
 check "sweep: --repeat 0 is a usage error (2)" test $? -eq 2
 check "sweep: ... naming --repeat" grep -q -- "--repeat '0'" "$T/rep.out"
