@@ -179,39 +179,56 @@ static double worth_samples(const struct accum_worth *w)
 	return w->a / w->d < 1.0 ? 1.0 : w->a / w->d;
 }
 
+/* Pixel (x, y)'s value in an antialiased render f times the image's size
+ * (1, or ACC_GRID_FRAME in scale 2's place): the mean of its f x f render
+ * pixels, into mean; 0 if one is not finite. */
+static int aa_pixel(const struct image *img, int oy, const int ch[3], int f, int x, int y,
+		    double mean[3])
+{
+	int ok = 1;
+	for (int c = 0; c < 3; c++)
+		mean[c] = 0.0;
+	for (int j = 0; j < f; j++)
+		for (int l = 0; l < f; l++) {
+			const float *p = img->px + ((size_t)(y * f + j - oy) * img->w +
+						    (size_t)x * f + l) * img->nch;
+			for (int c = 0; c < 3; c++) {
+				mean[c] += p[ch[c]] / (double)(f * f);
+				ok &= isfinite(p[ch[c]]) != 0;
+			}
+		}
+	return ok;
+}
+
 /* The worth of an antialiased render of a region (worth_samples()),
  * rounded. */
 static int aa_worth(const struct image *acc, const struct image *img, int oy, const int ch[3],
-		    int x0, int y0, int x1, int y1)
+		    int f, int x0, int y0, int x1, int y1)
 {
 	struct accum_worth w = {0};
 	for (int y = y0; y <= y1; y++)
 		for (int x = x0; x <= x1; x++) {
-			const float *p = img->px + ((size_t)(y - oy) * img->w + x) * img->nch;
-			double mean[3] = { p[ch[0]], p[ch[1]], p[ch[2]] };
+			double mean[3];
+			aa_pixel(img, oy, ch, f, x, y, mean);
 			worth_add(acc, (size_t)y * acc->w + x, ACC_AA, mean, &w);
 		}
 	return (int)lround(worth_samples(&w));
 }
 
-/* Fold an antialiased render at scale 1 (see aa_worth()). */
+/* Fold an antialiased render f times the image's size (see aa_worth()). */
 static long merge_aa(struct image *acc, const struct image *img, int oy, const int ch[3],
-		     int x0, int y0, int x1, int y1, int pass)
+		     int f, int x0, int y0, int x1, int y1, int pass)
 {
-	int n = aa_worth(acc, img, oy, ch, x0, y0, x1, y1);
+	int n = aa_worth(acc, img, oy, ch, f, x0, y0, x1, y1);
 	long count = 0;
 	for (int y = y0; y <= y1; y++)
 		for (int x = x0; x <= x1; x++) {
 			size_t i = (size_t)y * acc->w + x;
 			const float *o = acc->px + i * ACC_NCH;
-			const float *p = img->px + ((size_t)(y - oy) * img->w + x) * img->nch;
 			double mean[3], old[3], m2[3] = { 0.0, 0.0, 0.0 };
-			int ok = 1;
-			for (int c = 0; c < 3; c++) {
-				mean[c] = p[ch[c]];
+			int ok = aa_pixel(img, oy, ch, f, x, y, mean);
+			for (int c = 0; c < 3; c++)
 				old[c] = o[c];
-				ok &= isfinite(mean[c]) != 0;
-			}
 			if (!ok) {
 				accum_fold(acc, i, ACC_AA, 0, mean, m2, pass);
 				continue;
@@ -221,11 +238,11 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			 * pixel's spread is small would be weighted as the region's
 			 * noisier pixels prove it worth).  A pixel with no spread
 			 * to weigh it by (the base pass's one sample) takes it as
-			 * ACC_AA_FIRST samples, in place of scale 2 */
+			 * ACC_AA_FIRST samples */
 			struct accum_worth one = {0};
 			worth_add(acc, i, ACC_AA, mean, &one);
 			double own = worth_samples(&one);
-			const int first = !(o[ACC_SAMPLES] >= 2.0f) && !accum_has_scale(acc, i, 2);
+			const int first = !(o[ACC_SAMPLES] >= 2.0f);
 			int k = first ? ACC_AA_FIRST : own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
 			for (int c = 0; c < 3; c++)
 				m2[c] = k > 1 && !first ? (double)o[ACC_VAR_R + c] * (k - 1) : 0.0;
@@ -233,9 +250,11 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			if (accum_fold(acc, i, ACC_AA, k, mean, m2, pass))
 				continue;
 			count++;
-			if (first)
-				acc->px[i * ACC_NCH + ACC_SCALES] =
-					(float)(scale_mask(acc, i) | 1u << 2);
+			/* the render stands in for scale 2 where the pixel lacks
+			 * it: the planner moves on to scale 4 (a pixel planned at
+			 * scale 2 again would get no new render: its jitter is the
+			 * same every run) */
+			acc->px[i * ACC_NCH + ACC_SCALES] = (float)(scale_mask(acc, i) | 1u << 2);
 			if (!(na > 0.0))
 				continue;
 			/* the error of the new mean, not knowing which of the two
@@ -310,8 +329,9 @@ static long merge_grid(struct image *acc, const struct image *img, int oy, const
  * 4 or more at twice the width), else accum_render_factor(s). */
 static int render_frame(int s, int render_w, int image_w)
 {
-	return s >= 4 && render_w == image_w * ACC_GRID_FRAME ? ACC_GRID_FRAME
-							       : accum_render_factor(s);
+	return (s >= 4 || s == ACC_AA) && render_w == image_w * ACC_GRID_FRAME
+		       ? ACC_GRID_FRAME
+		       : accum_render_factor(s);
 }
 
 int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
@@ -332,7 +352,7 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 	}
 	const int f = render_frame(s, img->w, acc->w), grid = f != accum_render_factor(s);
 	if (img->w != acc->w * f) {
-		if (s >= 4)
+		if (s >= 4 || s == ACC_AA)
 			errbuf_printf(err, errlen,
 				      "the render is %d pixels wide, not %d (%d x %d) or %d (a grid "
 				      "render)", img->w, acc->w * f, acc->w, f,
@@ -355,8 +375,8 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 	}
 	const int ch[3] = { ir, ig, ib };
 	if (s == ACC_AA || grid) {
-		long c = grid ? merge_grid(acc, img, oy, ch, s, x0, y0, x1, y1, pass)
-			      : merge_aa(acc, img, oy, ch, x0, y0, x1, y1, pass);
+		long c = s == ACC_AA ? merge_aa(acc, img, oy, ch, f, x0, y0, x1, y1, pass)
+				     : merge_grid(acc, img, oy, ch, s, x0, y0, x1, y1, pass);
 		if (folded)
 			*folded = c;
 		return 0;
@@ -409,7 +429,7 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 	if (folded)
 		*folded = 0;
 	int f = accum_render_factor(s), w, h;
-	if (s >= 4) {	/* a grid render or not: the render's width says */
+	if (s >= 4 || s == ACC_AA) {	/* a grid render or not: the render's width says */
 		if (image_exr_size(path, &w, &h, err, errlen))
 			return -1;
 		f = render_frame(s, w, acc->w);
@@ -421,14 +441,17 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 }
 
 /* The finest scale pixel i has been sampled at; an antialiased render
- * (which subdivides to 1/16 of a pixel where corners differ) counts as 8. */
+ * after scale 4 (--sampler aa: +A0, subdividing to 1/16 of a pixel where
+ * corners differ at all) counts as 8.  In scale 2's place (+A0.1) it counts
+ * as 2: where the corners differ by less than the threshold its samples
+ * are half a pixel apart. */
 static int finest_scale(const struct image *acc, size_t i)
 {
 	int best = 1;
 	for (int k = 0; k < ACC_NSCALES; k++)
 		if (accum_has_scale(acc, i, accum_scales[k]))
 			best = accum_scales[k];
-	if (accum_has_scale(acc, i, ACC_AA) && best < 8)
+	if (accum_has_scale(acc, i, ACC_AA) && accum_has_scale(acc, i, 4) && best < 8)
 		best = 8;
 	return best;
 }

@@ -55,14 +55,15 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
 #define ACC_AA_MAX 289
 
 /*
- * An antialiased render in place of scale 2 (+A0.1; see render.c's
- * choose_samplers()): a pixel with fewer than 2 samples, whose spread
- * cannot weigh it, takes it as this many samples and as having had scale
- * 2.  POV-Ray subdivides a pixel up to 289 times where its corners differ,
- * and at a highlight the render is far closer than the base pass's one
- * sample: on hdr_highlights at 160x120 a weight of 1 ended at relMSE
- * 6.7e-4, 4 at 5.3e-4, 8 at 4.1e-4, 16 at 3.3e-4 and 64 at 3.6e-4 (target
- * 1e-3, one run each).
+ * An antialiased render in place of scale 2 (+AM2 +A0.1 +R3 +J at twice the
+ * image's size; see render.c's choose_samplers()): a pixel with fewer than
+ * 2 samples, whose spread cannot weigh it, takes it as this many samples,
+ * and every pixel it is folded into as having had scale 2.  POV-Ray
+ * subdivides where corners differ, and at a highlight the render is far
+ * closer than the base pass's one sample: on hdr_highlights at 160x120 a
+ * weight of 1 ended at relMSE 6.7e-4, 4 at 5.3e-4, 8 at 4.1e-4, 16 at 3.3e-4
+ * and 64 at 3.6e-4 (target 1e-3, one run each, with the render then at the
+ * image's size, +R4).
  */
 #define ACC_AA_FIRST 16
 

@@ -858,7 +858,7 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 	      struct pov_region *region, const char **extra, struct pov_job *job)
 {
 	const int grid = r->frame > 0 && r->scale >= 4;
-	int s = grid ? ACC_GRID_FRAME : accum_render_factor(r->scale);
+	int s = r->frame > 0 ? r->frame : accum_render_factor(r->scale);
 	*job = *base;
 	job->output = output;
 	job->width = base->width * s;
@@ -876,7 +876,7 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 		/* POV-Ray's own adaptive antialiasing, jittered (accum.h) */
 		extra[job->nextra++] = "+AM2";
 		extra[job->nextra++] = r->aa_first ? "+A0.1" : "+A0.0";
-		extra[job->nextra++] = "+R4";
+		extra[job->nextra++] = r->aa_first ? "+R3" : "+R4";
 		extra[job->nextra++] = "+J";
 	} else if (grid) {
 		/* every pixel of the render supersampled (accum.h) */
@@ -1003,4 +1003,30 @@ fail:
 	*outputs = NULL;
 	*passes = NULL;
 	return -1;
+}
+
+/* qsort() order for plan_sparse_error(): the largest first */
+static int by_descending(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return x < y ? 1 : x > y ? -1 : 0;
+}
+
+int plan_sparse_error(const double *e, size_t n)
+{
+	size_t m = (size_t)(PLAN_SPARSE_SHARE * (double)n), top = m ? m : 1;
+	double *v = malloc(n * sizeof(*v)), all = 0.0, big = 0.0;
+	if (!v)
+		return 0;	/* the default samplers serve either way */
+	size_t k = 0;
+	for (size_t i = 0; i < n; i++)
+		if (isfinite(e[i]) && e[i] > 0.0) {
+			v[k++] = e[i];
+			all += e[i];
+		}
+	qsort(v, k, sizeof(*v), by_descending);
+	for (size_t i = 0; i < top && i < k; i++)
+		big += v[i];
+	free(v);
+	return all > 0.0 && big >= 0.5 * all;
 }

@@ -88,8 +88,8 @@ static const char usage_options[] =
 	"                        the scales whose scaled frame would exceed 1 Mpixel,\n"
 	"                        scale below; and where the estimated error sits in a\n"
 	"                        few pixels, 0.1% of them holding half of it, as at\n"
-	"                        highlights, scale 2 as one render at scale 1 with\n"
-	"                        POV-Ray's +AM2 +A0.1 +R4 +J), grid (scales 4, 8 and\n"
+	"                        highlights, scale 2 as one render at twice the size\n"
+	"                        with POV-Ray's +AM2 +A0.1 +R3 +J), grid (scales 4, 8 and\n"
 	"                        16 as renders at twice the size with POV-Ray's +AM1\n"
 	"                        +A0.0 +R(scale/2) +J0.5: scale x scale jittered\n"
 	"                        samples), scale (resolution scaling throughout: the\n";
@@ -793,55 +793,31 @@ static long lacking_aa(const struct run *r, const struct plan_region *g)
 	return n;
 }
 
-/*
- * Whether the estimated error e (n pixels) sits in a few pixels: the
- * largest tenth of a percent of them (at least one) holding half of it or
- * more.  So it does at highlights seen directly and in mirrors, each a few
- * pixels whose samples scatter tens of times their mean; not where noise
- * or edges spread over the frame.  After the base pass at 160x120, the
- * share was 0.63 on hdr_highlights (0.66 at 320x240, 0.26 at 80x60, where
- * 0.1% is 4 pixels), 0.01 to 0.11 on the other bundled scenes (radiosity_room
- * 0.26 at 320x240), and 0.02 to 0.09 on Debian's arealit2, glassthing,
- * laser, spotlite, circular, woodbox and focalblur.
- */
-#define SPARSE_SHARE 0.001
-
-static int by_descending(const void *a, const void *b)
+/* Whether plan pl has a region of scale 2. */
+static int has_scale2(const struct plan *pl)
 {
-	double x = *(const double *)a, y = *(const double *)b;
-	return x < y ? 1 : x > y ? -1 : 0;
-}
-
-static int sparse_error(const double *e, size_t n)
-{
-	size_t m = (size_t)(SPARSE_SHARE * (double)n), top = m ? m : 1;
-	double *v = malloc(n * sizeof(*v)), all = 0.0, big = 0.0;
-	if (!v)
-		return 0;	/* the default samplers serve either way */
-	size_t k = 0;
-	for (size_t i = 0; i < n; i++)
-		if (isfinite(e[i]) && e[i] > 0.0) {
-			v[k++] = e[i];
-			all += e[i];
-		}
-	qsort(v, k, sizeof(*v), by_descending);
-	for (size_t i = 0; i < top && i < k; i++)
-		big += v[i];
-	free(v);
-	return all > 0.0 && big >= 0.5 * all;
+	for (size_t k = 0; k < pl->nregions; k++)
+		if (pl->regions[k].scale == 2)
+			return 1;
+	return 0;
 }
 
 /*
  * The sampler of each region of a plan.  With --sampler auto, where the
- * error sits in a few pixels (sparse_error()), the regions of scale 2 are
- * rendered once at scale 1 with POV-Ray's antialiasing at threshold 0.1
- * (aa_first; ACC_AA_FIRST for how they are folded): it subdivides only the
- * pixels whose corners differ, up to 289 samples at a highlight, where
- * scale 2 gives every pixel of the rectangles 4 (hdr_highlights at 160x120
- * and target 3e-3: relMSE 1.7e-3 in 1.0 CPU s with scale 2, about 3e-4 in
- * 2.0 s with the antialiased render, where POV-Ray's own best at 2 CPU s has
- * 4.7e-4; on the scenes whose error is spread, the same render was 1.1 to
- * 22 times worse than scale 2).  Fine regions (scale 8 or 16: their pixels
+ * error sits in a few pixels (plan_sparse_error()), the regions of scale 2 are
+ * rendered once at twice the image's size with POV-Ray's antialiasing,
+ * +AM2 +A0.1 +R3 +J (aa_first; ACC_AA_FIRST for how they are folded): it
+ * subdivides only where corners differ, down to 1/16 of a pixel at a
+ * highlight, where scale 2 gives every pixel of the rectangles 4 samples;
+ * at twice the size its corners are scale 2's density where it does not
+ * (at the image's size, stars between corners went unseen: a pixel's base
+ * sample and render agreed on black, its estimate was 0).  hdr_highlights
+ * at 160x120 and target 3e-3: relMSE 1.7e-3 in 1.0 CPU s with scale 2,
+ * 3.1e-4 in 2.2 s so, where POV-Ray's own best at 2 CPU s has 4.7e-4; on the
+ * scenes whose error is spread, rendering every scale-2 region so did not
+ * help and under a 2 s budget was 15 to 22 times worse (see the README).
+ * The antialiased regions go last (folded after the others, the same in
+ * render as in regions.tsv).  Fine regions (scale 8 or 16: their pixels
  * have 21 samples or more) get resolution scaling, or with --sampler aa POV-Ray's
  * own antialiasing (ACC_AA) for the regions most of whose pixels have had
  * none (once per pixel: its jitter pattern is the same every run).  The
@@ -851,13 +827,22 @@ static int sparse_error(const double *e, size_t n)
  */
 static void choose_samplers(const struct run *r, struct plan *pl)
 {
-	if (r->grid == PLAN_GRID_LARGE && !r->aa && sparse_error(r->est, (size_t)r->w * r->h)) {
-		for (size_t k = 0; k < pl->nregions; k++)
-			if (pl->regions[k].scale == 2) {
-				pl->regions[k].scale = ACC_AA;
-				pl->regions[k].aa_first = 1;
-				pl->regions[k].frame = 0;
-			}
+	if (r->grid == PLAN_GRID_LARGE && !r->aa && has_scale2(pl) &&
+	    plan_sparse_error(r->est, (size_t)r->w * r->h)) {
+		/* folded last, as below */
+		size_t m = 0;
+		for (size_t k = 0; k < pl->nregions; k++) {
+			struct plan_region g = pl->regions[k];
+			if (g.scale == 2)
+				continue;
+			memmove(pl->regions + m + 1, pl->regions + m, (k - m) * sizeof(g));
+			pl->regions[m++] = g;
+		}
+		for (size_t k = m; k < pl->nregions; k++) {
+			pl->regions[k].scale = ACC_AA;
+			pl->regions[k].aa_first = 1;
+			pl->regions[k].frame = ACC_GRID_FRAME;
+		}
 		return;
 	}
 	if (!r->aa)
@@ -1032,7 +1017,12 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		}
 		p.regions++;
 		p.pixels += folded;
-		p.samples += s == ACC_AA ? 0.0 : (double)folded * s * s;
+		/* an antialiased render's samples: the camera rays POV-Ray
+		 * counted (its corners are shared between pixels) */
+		p.samples += s != ACC_AA ? (double)folded * s * s
+			     : results[k].stats.pixels > 0
+				     ? (double)(results[k].stats.pixels + results[k].stats.samples)
+				     : 0.0;
 		if (!r->keep)
 			unlink(outs[k]);
 	}

@@ -560,7 +560,7 @@ summarize() {
 			print line "\t" bo "\t" bc "\t" bset "\t" s1[sc] "\t" sm[sc] "\t" \
 				med "\t" bh
 		}
-	}' "$CSV" "$rep"
+	}' "$CSV"
 }
 
 g3() { awk -v x="$1" 'BEGIN { if (x == "-" || x == "") print "-"; else printf "%.3g", x }'; }

@@ -237,7 +237,7 @@ check "sweep: a run cheaper than every POV-Ray run ranks last" \
 eval "$(sed -n '/^pp_table() {/,/^}/p' "$ROOT/scripts/sweep.sh")"
 CSV=$T/pp.csv RCSV=$T/pp-rep.csv REPEAT=3
 printf '%s\n' scene,method,setting,cpu_s,wall_s,relmse,psnr,est,cap,orc \
-	A,noaa,-,0.1,1,0.01,,,, A,am2,x,1.0,1,0.001,,,, A,povpress,t,1.5,1,0.002,0.001,0.5,0.9 \
+	A,noaa,-,0.1,1,0.01,,,, A,am2,x,1.0,1,0.001,,,, A,povpress,t,1.5,1,0.002,40,0.001,0.5,0.9 \
 	>"$CSV"
 printf '%s\n' scene,method,setting,cpu_s,wall_s,relmse,psnr,est,cap,orc \
 	A,povpress,t,0.5,1,0.004,,,, A,povpress,t,1.5,1,0.002,,,, A,povpress,t,0.2,1,0.03,,,, \

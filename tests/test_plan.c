@@ -571,7 +571,7 @@ static void test_merge_aa(void **state)
 		capped += k[i] < pool;
 	}
 	assert_true(capped >= 1 && capped <= 3);
-	accpx(&acc, 7)[ACC_SCALES] = (float)(1u << 1 | 1u << 2);
+	accpx(&acc, 7)[ACC_SCALES] = (float)(1u << 1 | 1u << 4);
 	float before[8][ACC_NCH];
 	for (int i = 0; i < 8; i++)
 		memcpy(before[i], accpx(&acc, (size_t)i), sizeof(before[i]));
@@ -601,18 +601,20 @@ static void test_merge_aa(void **state)
 		double want = wb * wb * d + wa * wa * em;
 		assert_close(o[ACC_DIFF], want, 1e-5, 0.0, "difference over the weights");
 	}
-	/* a pixel with one sample has no spread to weigh the render by: the
-	 * render takes scale 2's place as ACC_AA_FIRST samples (pixel 7 has
-	 * had scale 2: there it counts as one sample) */
-	for (int i = 4; i < 8; i++) {
+	/* a pixel with one sample has no spread to weigh the render by: it
+	 * takes the render as ACC_AA_FIRST samples; and every pixel folded
+	 * has scale 2 after it (the render stands in for it: planned at scale
+	 * 2 again, a pixel would get the same render, which it refuses) */
+	for (int i = 0; i < 8; i++) {
 		const float *o = accpx(&acc, (size_t)i);
-		const int n = i == 7 ? 1 : ACC_AA_FIRST;
-		assert_true(o[ACC_SAMPLES] == (float)(1 + n));
-		assert_close(o[0], (before[i][0] + n * (double)r.px[i * 3]) / (1 + n), 1e-6, 0.0,
-			     "the base sample and the render");
 		assert_true(accum_has_scale(&acc, (size_t)i, 2));
 		assert_true(accum_has_scale(&acc, (size_t)i, ACC_AA));
-		assert_true(accum_next_scale(&acc, (size_t)i) == 4);
+		assert_true(accum_next_scale(&acc, (size_t)i) == (i == 7 ? 8 : 4));
+		if (i < 4)
+			continue;
+		assert_true(o[ACC_SAMPLES] == (float)(1 + ACC_AA_FIRST));
+		assert_close(o[0], (before[i][0] + ACC_AA_FIRST * (double)r.px[i * 3]) /
+				   (1 + ACC_AA_FIRST), 1e-6, 0.0, "the base sample and the render");
 	}
 	/* once per pixel: the same render again changes nothing */
 	float after[ACC_NCH];
@@ -621,12 +623,33 @@ static void test_merge_aa(void **state)
 					    sizeof(err)), 0);
 	assert_int_equal(folded, 0);
 	assert_memory_equal(after, accpx(&acc, 0), sizeof(after));
-	/* the render is at scale 1: a 2x render is the wrong size */
+	/* the render is at the image's size or twice it: 3x is the wrong size */
 	struct image big;
-	make_render(&big, 8, 0, 4, 2);
+	make_render(&big, 12, 0, 6, 3);
 	assert_int_equal(accum_merge_region(&acc, &big, 0, ACC_AA, 0, 0, 3, 1, 5, &folded, err,
 					    sizeof(err)), -1);
-	assert_non_null(strstr(err, "8 pixels wide, not 4"));
+	assert_non_null(strstr(err, "12 pixels wide, not 4"));
+	image_release(&big);
+	image_release(&acc);
+
+	/* in scale 2's place the render is twice the size: a pixel takes the
+	 * mean of its 2 x 2 render pixels */
+	make_acc(&acc, 4, 2, flat_value);
+	make_render(&big, 8, 0, 4, 2);
+	assert_int_equal(accum_merge_region(&acc, &big, 0, ACC_AA, 0, 0, 3, 1, 1, &folded, err,
+					    sizeof(err)), 0);
+	assert_int_equal(folded, 8);
+	for (int i = 0; i < 8; i++) {
+		const int x = i % 4, y = i / 4;
+		double m = 0.0;
+		for (int j = 0; j < 2; j++)
+			for (int l = 0; l < 2; l++)
+				m += render_at(&big, 0, 2 * x + l, 2 * y + j, 0) / 4.0;
+		assert_true(accpx(&acc, (size_t)i)[ACC_SAMPLES] == (float)(1 + ACC_AA_FIRST));
+		assert_close(accpx(&acc, (size_t)i)[0],
+			     (flat_value(x, y, 0) + ACC_AA_FIRST * m) / (1 + ACC_AA_FIRST), 1e-6,
+			     0.0, "the base sample and the 2 x 2 mean");
+	}
 	image_release(&big);
 	image_release(&acc);
 
@@ -1250,6 +1273,43 @@ static void test_final_choice(void **state)
 	image_release(&acc);
 }
 
+/* 6b. plan_sparse_error(): the largest 0.1% (at least one) of the pixels'
+ * errors holding half of their sum. */
+static void test_sparse_error(void **state)
+{
+	enum { N = 3000 };	/* 0.1% is 3 pixels */
+	double e[N];
+
+	(void)state;
+	for (int i = 0; i < N; i++)
+		e[i] = 1e-4;
+	assert_false(plan_sparse_error(e, N));	/* spread */
+	/* three pixels holding 0.3 / (0.3 + 0.2997): just over half */
+	e[10] = e[500] = e[2999] = 0.1;
+	assert_true(plan_sparse_error(e, N));
+	/* four such pixels: the largest three hold 0.3 of 0.4 + 0.2996 */
+	e[7] = 0.1;
+	assert_false(plan_sparse_error(e, N));
+	/* three, and the rest holding more than they: 0.3 of 0.3 + 0.5994 */
+	e[7] = 1e-4;
+	for (int i = 0; i < N; i++)
+		if (e[i] < 0.05)
+			e[i] = 2e-4;
+	assert_false(plan_sparse_error(e, N));
+	/* what is not finite or not positive is left out */
+	for (int i = 0; i < N; i++)
+		e[i] = i % 3 == 0 ? NAN : i % 3 == 1 ? -1.0 : 0.0;
+	assert_false(plan_sparse_error(e, N));	/* nothing left */
+	e[1] = INFINITY;
+	e[2] = 1e-3;
+	assert_true(plan_sparse_error(e, N));	/* one finite pixel holds it all */
+	/* a small image: at least one pixel */
+	double f[5] = { 1.0, 0.2, 0.2, 0.2, 0.2 };
+	assert_true(plan_sparse_error(f, 5));
+	f[0] = 0.7;
+	assert_false(plan_sparse_error(f, 5));
+}
+
 /* 7. The regions file round-trips; a bad line is reported with its number. */
 static void test_regions_file(void **state)
 {
@@ -1379,12 +1439,14 @@ static void test_plan_job(void **state)
 	assert_int_equal(region.y1, 7);
 	assert_string_equal(job.extra[1], "Antialias_Threshold=0.1");
 	assert_aa_options(&job, "+AM2", "+A0.0", "+R4", "+J");
-	/* in scale 2's place: threshold 0.1 */
+	/* in scale 2's place: twice the size, threshold 0.1, depth 3 */
 	r.aa_first = 1;
+	r.frame = ACC_GRID_FRAME;
 	plan_job(&base, &r, "out/a1.exr", &region, aextra, &job);
-	assert_int_equal(job.width, 64);
-	assert_aa_options(&job, "+AM2", "+A0.1", "+R4", "+J");
+	assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
+	assert_aa_options(&job, "+AM2", "+A0.1", "+R3", "+J");
 	r.aa_first = 0;
+	r.frame = 0;
 	char name[64];
 	plan_output_name(name, sizeof(name), "w", 3, 7, ACC_AA);
 	assert_string_equal(name, "w/p03-r007-aa.exr");
@@ -1473,6 +1535,7 @@ int main(void)
 		cmocka_unit_test(test_plan_budget),
 		cmocka_unit_test(test_pixel_errors),
 		cmocka_unit_test(test_final_choice),
+		cmocka_unit_test(test_sparse_error),
 		cmocka_unit_test(test_regions_file),
 		cmocka_unit_test(test_plan_job),
 	};
