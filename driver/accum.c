@@ -340,9 +340,9 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 {
 	if (folded)
 		*folded = 0;
-	if (s != ACC_AA && (s < 1 || s > 16 || (s & (s - 1)) != 0)) {
-		errbuf_printf(err, errlen, "scale %d is not one of 0 (antialiased), 1, 2, 4, 8, 16",
-			      s);
+	if (s != ACC_AA && s != 3 && (s < 1 || s > 16 || (s & (s - 1)) != 0)) {
+		errbuf_printf(err, errlen, "scale %d is not one of 0 (antialiased), 1, 2, 3 (a "
+			      "radiosity pass), 4, 8, 16", s);
 		return -1;
 	}
 	if (x0 < 0 || y0 < 0 || x1 >= acc->w || y1 >= acc->h || x0 > x1 || y0 > y1) {

@@ -75,8 +75,9 @@ static const char usage_options[] =
 	"                        at K x the size on one thread for the radiosity\n"
 	"                        solution and keep its K x K samples per pixel (1, 2, 4\n"
 	"                        or 8; default: the smallest power of two making it\n"
-	"                        480+ pixels wide, at most 4, under a --budget halved\n"
-	"                        down to 2 until the pass fits; 0: no such pass)\n"
+	"                        480+ pixels wide, at most 4, under a --budget\n"
+	"                        lowered (4, 3, 2) until the pass fits; 0: no such\n"
+	"                        pass)\n"
 	"  --workdir DIR         keep intermediate files here (default OUT.exr.work)\n"
 	"  --keep-workdir        do not remove the work directory after success\n"
 	"  --resume              continue the run the work directory holds\n"
@@ -629,11 +630,12 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	/* under a budget, a solution on a smaller frame beats none: the region
 	 * renders would load the base pass's (radiosity_room at 160x120,
 	 * --budget 2: relMSE 3.6e-3 in 0.52 CPU s with scale 2's, 4.1e-3 to
-	 * 6.1e-3 in 0.83 to 1.1 s with the base pass's); a --radiosity-scale
-	 * stands */
+	 * 6.1e-3 in 0.83 to 1.1 s with the base pass's); scale 4 gives way to
+	 * 3 before 2 (POV-Ray's scale 3 alone had 1.6e-3 in 0.47 CPU s, where
+	 * the pass at scale 2 left 3.6e-3); a --radiosity-scale stands */
 	while (r->budget > 0.0 && r->user_rad_scale < 0 && k > 2 &&
 	       elapsed(r) + radiosity_time(r, k) > r->budget)
-		k /= 2;
+		k = k == 4 ? 3 : k == 3 ? 2 : k / 2;
 	double predicted = radiosity_time(r, k);
 	if (r->budget > 0.0 && elapsed(r) + predicted > r->budget) {
 		if (r->verbose)
@@ -660,7 +662,8 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	    image_init(&acc, r->w, r->h, ACC_NCH, accum_names, err, errlen))
 		goto out;
 	/* a fresh accumulation that counts the scales below k as done: the
-	 * next samples come at 2k, at positions none of these has */
+	 * next samples come at the next power of two past k, at positions none
+	 * of these has (scale 3's are at 1/6, 1/2 and 5/6 of a pixel) */
 	uint32_t below = 0;
 	for (int s = 1; s < k; s *= 2)
 		below |= 1u << s;
