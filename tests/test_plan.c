@@ -447,15 +447,26 @@ static void test_merge_region(void **state)
 					    sizeof(err)), -1);
 	assert_int_equal(accum_merge_region(&acc, &r2, oy2, 2, -1, 10, 3, 11, 6, &folded, err,
 					    sizeof(err)), -1);
-	/* scale 3, with a render of the matching width */
-	make_render(&bad, 3 * W, 0, 3 * H, 3);
+	/* scale 5, with a render of the matching width */
+	make_render(&bad, 5 * W, 0, 5 * H, 5);
 	err[0] = '\0';
-	assert_int_equal(accum_merge_region(&acc, &bad, 0, 3, 0, 0, 1, 1, 6, &folded, err,
+	assert_int_equal(accum_merge_region(&acc, &bad, 0, 5, 0, 0, 1, 1, 6, &folded, err,
 					    sizeof(err)), -1);
-	assert_non_null(strstr(err, "3"));
+	assert_non_null(strstr(err, "scale 5 is not one of"));
 	assert_int_equal(folded, 0);
 	image_release(&bad);
 	assert_memory_equal(snap, acc.px, bytes);
+	/* scale 3 (a radiosity pass under a budget): 9 samples a pixel */
+	struct image a3;
+	make_acc(&a3, 4, 2, flat_value);
+	make_render(&bad, 12, 0, 6, 3);
+	assert_int_equal(accum_merge_region(&a3, &bad, 0, 3, 0, 0, 3, 1, 1, &folded, err,
+					    sizeof(err)), 0);
+	assert_int_equal(folded, 8);
+	assert_true(accpx(&a3, 5)[ACC_SAMPLES] == 10.0f);
+	assert_true(accum_has_scale(&a3, 5, 3));
+	image_release(&bad);
+	image_release(&a3);
 
 	free(orig);
 	free(snap);
