@@ -830,38 +830,23 @@ static int has_scale2(const struct plan *pl)
  */
 static void choose_samplers(const struct run *r, struct plan *pl)
 {
-	if (r->grid == PLAN_GRID_LARGE && !r->aa && has_scale2(pl) &&
-	    plan_sparse_error(r->est, (size_t)r->w * r->h)) {
-		/* folded last, as below */
-		size_t m = 0;
-		for (size_t k = 0; k < pl->nregions; k++) {
-			struct plan_region g = pl->regions[k];
-			if (g.scale == 2)
-				continue;
-			memmove(pl->regions + m + 1, pl->regions + m, (k - m) * sizeof(g));
-			pl->regions[m++] = g;
-		}
-		for (size_t k = m; k < pl->nregions; k++) {
-			pl->regions[k].scale = ACC_AA;
-			pl->regions[k].aa_first = 1;
-			pl->regions[k].frame = ACC_GRID_FRAME;
-		}
-		return;
-	}
-	if (!r->aa)
+	const int first = r->grid == PLAN_GRID_LARGE && !r->aa && has_scale2(pl) &&
+			  plan_sparse_error(r->est, (size_t)r->w * r->h);
+	if (!first && !r->aa)
 		return;
 	size_t m = 0;
 	for (size_t k = 0; k < pl->nregions; k++) {
 		struct plan_region g = pl->regions[k];
 		long area = (long)(g.x1 - g.x0 + 1) * (g.y1 - g.y0 + 1);
-		if (g.scale >= 8 && 2 * lacking_aa(r, &g) >= area)
+		if (first ? g.scale == 2 : g.scale >= 8 && 2 * lacking_aa(r, &g) >= area)
 			continue;
 		memmove(pl->regions + m + 1, pl->regions + m, (k - m) * sizeof(g));
 		pl->regions[m++] = g;
 	}
 	for (size_t k = m; k < pl->nregions; k++) {
 		pl->regions[k].scale = ACC_AA;
-		pl->regions[k].frame = 0;
+		pl->regions[k].aa_first = first;
+		pl->regions[k].frame = first ? ACC_GRID_FRAME : 0;
 	}
 }
 
