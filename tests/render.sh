@@ -353,6 +353,20 @@ done
 check "... merge folds it to render's accumulation, bit for bit" \
 	idiff -fail 0 -failpercent 0 "$T/gm-acc2-ch.exr" "$T/gm.work-accum-ch.exr"
 
+# --- merge folds an antialiased first pass (twice the size) as render does ---
+"$PP" render "$SC/starfield.pov" -o "$T/af.exr" -W 80 -H 60 --jobs 1 --max-passes 1 -q \
+	--keep-workdir --workdir "$T/af.work" -- +WT1 &&
+	"$PP" merge --init "$T/af.work/base.exr" -o "$T/af-acc0.exr" &&
+	"$PP" merge "$T/af-acc0.exr" "$T/af.work/regions.tsv" -o "$T/af-acc1.exr" >/dev/null
+check "starfield, one pass: render, then merge its regions.tsv: runs" test $? -eq 0
+check "... the pass was antialiased (scale 0 in regions.tsv)" \
+	grep -qP '^1\t(\d+\t){4}0\t' "$T/af.work/regions.tsv"
+for f in af-acc1 af.work/accum; do
+	oiiotool "$T/$f.exr" --ch R,G,B,samples,scales,diff -o "$T/${f//\//-}-ch.exr" 2>/dev/null
+done
+check "... merge folds it to render's accumulation, bit for bit" \
+	idiff -fail 0 -failpercent 0 "$T/af-acc1-ch.exr" "$T/af.work-accum-ch.exr"
+
 # --- a region job that crashes or hangs: retried, reported, image valid -----
 cat >"$T/fakepov" <<'EOF'
 #!/bin/sh
