@@ -242,7 +242,8 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			struct accum_worth one = {0};
 			worth_add(acc, i, ACC_AA, mean, &one);
 			double own = worth_samples(&one);
-			const int first = !(o[ACC_SAMPLES] >= 2.0f);
+			const int half = f == ACC_GRID_FRAME;	/* in scale 2's place */
+			const int first = half && !(o[ACC_SAMPLES] >= 2.0f);
 			int k = first ? ACC_AA_FIRST : own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
 			for (int c = 0; c < 3; c++)
 				m2[c] = k > 1 && !first ? (double)o[ACC_VAR_R + c] * (k - 1) : 0.0;
@@ -250,11 +251,13 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			if (accum_fold(acc, i, ACC_AA, k, mean, m2, pass))
 				continue;
 			count++;
-			/* the render stands in for scale 2 where the pixel lacks
-			 * it: the planner moves on to scale 4 (a pixel planned at
-			 * scale 2 again would get no new render: its jitter is the
-			 * same every run) */
-			acc->px[i * ACC_NCH + ACC_SCALES] = (float)(scale_mask(acc, i) | 1u << 2);
+			/* in scale 2's place the render stands in for scale 2: the
+			 * planner moves on to scale 4 (a pixel planned at scale 2
+			 * again would get no new render: its jitter is the same
+			 * every run), and ACC_AA_HALF marks it for finest_scale() */
+			if (half)
+				acc->px[i * ACC_NCH + ACC_SCALES] =
+					(float)(scale_mask(acc, i) | 1u << 2 | 1u << ACC_AA_HALF);
 			if (!(na > 0.0))
 				continue;
 			/* the error of the new mean, not knowing which of the two
@@ -354,9 +357,9 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 	if (img->w != acc->w * f) {
 		if (s >= 4 || s == ACC_AA)
 			errbuf_printf(err, errlen,
-				      "the render is %d pixels wide, not %d (%d x %d) or %d (a grid "
-				      "render)", img->w, acc->w * f, acc->w, f,
-				      acc->w * ACC_GRID_FRAME);
+				      "the render is %d pixels wide, not %d (%d x %d) or %d (%s)",
+				      img->w, acc->w * f, acc->w, f, acc->w * ACC_GRID_FRAME,
+				      s == ACC_AA ? "antialiased in scale 2's place" : "a grid render");
 		else
 			errbuf_printf(err, errlen, "the render is %d pixels wide, not %d (%d x %d)",
 				      img->w, acc->w * f, acc->w, f);
@@ -440,18 +443,18 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 	return rc ? -1 : 0;
 }
 
-/* The finest scale pixel i has been sampled at; an antialiased render
- * after scale 4 (--sampler aa: +A0, subdividing to 1/16 of a pixel where
- * corners differ at all) counts as 8.  In scale 2's place (+A0.1) it counts
- * as 2: where the corners differ by less than the threshold its samples
- * are half a pixel apart. */
+/* The finest scale pixel i has been sampled at; an antialiased render of
+ * --sampler aa (+A0, subdividing to 1/16 of a pixel where corners differ at
+ * all) counts as 8.  In scale 2's place (+A0.1, ACC_AA_HALF) it counts as 2:
+ * where the corners differ by less than the threshold its samples are half
+ * a pixel apart. */
 static int finest_scale(const struct image *acc, size_t i)
 {
 	int best = 1;
 	for (int k = 0; k < ACC_NSCALES; k++)
 		if (accum_has_scale(acc, i, accum_scales[k]))
 			best = accum_scales[k];
-	if (accum_has_scale(acc, i, ACC_AA) && accum_has_scale(acc, i, 4) && best < 8)
+	if (accum_has_scale(acc, i, ACC_AA) && !accum_has_scale(acc, i, ACC_AA_HALF) && best < 8)
 		best = 8;
 	return best;
 }

@@ -58,7 +58,9 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * An antialiased render in place of scale 2 (+AM2 +A0.1 +R3 +J at twice the
  * image's size; see render.c's choose_samplers()): a pixel with fewer than
  * 2 samples, whose spread cannot weigh it, takes it as this many samples,
- * and every pixel it is folded into as having had scale 2.  POV-Ray
+ * and every pixel it is folded into as having had scale 2 (--sampler aa's
+ * renders at the image's size are folded as before: a pixel with no spread
+ * takes one as 1 sample).  POV-Ray
  * subdivides where corners differ, and at a highlight the render is far
  * closer than the base pass's one sample: on hdr_highlights at 160x120 a
  * weight of 1 ended at relMSE 6.7e-4, 4 at 5.3e-4, 8 at 4.1e-4, 16 at 3.3e-4
@@ -66,6 +68,10 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * image's size, +R4).
  */
 #define ACC_AA_FIRST 16
+
+/* The bit of the scale mask that marks an antialiased render in scale 2's
+ * place (ACC_AA marks either kind; 5 is no scale). */
+#define ACC_AA_HALF 5
 
 /* A region render of scale s is accum_render_factor(s) times the image's
  * size: s, or 1 for an antialiased render. */

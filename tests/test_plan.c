@@ -612,20 +612,19 @@ static void test_merge_aa(void **state)
 		double want = wb * wb * d + wa * wa * em;
 		assert_close(o[ACC_DIFF], want, 1e-5, 0.0, "difference over the weights");
 	}
-	/* a pixel with one sample has no spread to weigh the render by: it
-	 * takes the render as ACC_AA_FIRST samples; and every pixel folded
-	 * has scale 2 after it (the render stands in for it: planned at scale
-	 * 2 again, a pixel would get the same render, which it refuses) */
+	/* a pixel with one sample has no spread to weigh the render by: the
+	 * render counts as one sample; and a render at the image's size does
+	 * not stand in for scale 2 */
 	for (int i = 0; i < 8; i++) {
 		const float *o = accpx(&acc, (size_t)i);
-		assert_true(accum_has_scale(&acc, (size_t)i, 2));
 		assert_true(accum_has_scale(&acc, (size_t)i, ACC_AA));
-		assert_true(accum_next_scale(&acc, (size_t)i) == (i == 7 ? 8 : 4));
+		assert_false(accum_has_scale(&acc, (size_t)i, 2));
+		assert_false(accum_has_scale(&acc, (size_t)i, ACC_AA_HALF));
+		assert_true(accum_next_scale(&acc, (size_t)i) == 2);
 		if (i < 4)
 			continue;
-		assert_true(o[ACC_SAMPLES] == (float)(1 + ACC_AA_FIRST));
-		assert_close(o[0], (before[i][0] + ACC_AA_FIRST * (double)r.px[i * 3]) /
-				   (1 + ACC_AA_FIRST), 1e-6, 0.0, "the base sample and the render");
+		assert_true(o[ACC_SAMPLES] == 2.0f);
+		assert_close(o[0], (before[i][0] + r.px[i * 3]) / 2.0, 1e-6, 0.0, "two samples");
 	}
 	/* once per pixel: the same render again changes nothing */
 	float after[ACC_NCH];
@@ -644,22 +643,36 @@ static void test_merge_aa(void **state)
 	image_release(&acc);
 
 	/* in scale 2's place the render is twice the size: a pixel takes the
-	 * mean of its 2 x 2 render pixels */
+	 * mean of its 2 x 2 render pixels, as ACC_AA_FIRST samples where it
+	 * has one; and every pixel folded has scale 2 after it (planned at
+	 * scale 2 again, it would get the same render, which it refuses) */
 	make_acc(&acc, 4, 2, flat_value);
+	float *o3 = accpx(&acc, 3);
+	for (int c = 0; c < 3; c++)
+		o3[ACC_VAR_R + c] = (float)var[c];
+	o3[ACC_SAMPLES] = 9.0f;
+	accpx(&acc, 6)[ACC_SCALES] = (float)(1u << 1 | 1u << 4);
 	make_render(&big, 8, 0, 4, 2);
 	assert_int_equal(accum_merge_region(&acc, &big, 0, ACC_AA, 0, 0, 3, 1, 1, &folded, err,
 					    sizeof(err)), 0);
 	assert_int_equal(folded, 8);
 	for (int i = 0; i < 8; i++) {
 		const int x = i % 4, y = i / 4;
+		const float *o = accpx(&acc, (size_t)i);
+		assert_true(accum_has_scale(&acc, (size_t)i, 2));
+		assert_true(accum_has_scale(&acc, (size_t)i, ACC_AA_HALF));
+		assert_true(accum_next_scale(&acc, (size_t)i) == (i == 6 ? 8 : 4));
+		if (i == 3) {	/* 9 samples: weighed as before */
+			assert_true(o[ACC_SAMPLES] > 9.0f && o[ACC_SAMPLES] != 9.0f + ACC_AA_FIRST);
+			continue;
+		}
 		double m = 0.0;
 		for (int j = 0; j < 2; j++)
 			for (int l = 0; l < 2; l++)
 				m += render_at(&big, 0, 2 * x + l, 2 * y + j, 0) / 4.0;
-		assert_true(accpx(&acc, (size_t)i)[ACC_SAMPLES] == (float)(1 + ACC_AA_FIRST));
-		assert_close(accpx(&acc, (size_t)i)[0],
-			     (flat_value(x, y, 0) + ACC_AA_FIRST * m) / (1 + ACC_AA_FIRST), 1e-6,
-			     0.0, "the base sample and the 2 x 2 mean");
+		assert_true(o[ACC_SAMPLES] == (float)(1 + ACC_AA_FIRST));
+		assert_close(o[0], (flat_value(x, y, 0) + ACC_AA_FIRST * m) / (1 + ACC_AA_FIRST),
+			     1e-6, 0.0, "the base sample and the 2 x 2 mean");
 	}
 	image_release(&big);
 	image_release(&acc);
