@@ -246,7 +246,7 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			const int first = half && !(o[ACC_SAMPLES] >= 2.0f);
 			int k = first ? ACC_AA_FIRST : own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
 			for (int c = 0; c < 3; c++)
-				m2[c] = k > 1 && !first ? (double)o[ACC_VAR_R + c] * (k - 1) : 0.0;
+				m2[c] = k > 1 ? (double)o[ACC_VAR_R + c] * (k - 1) : 0.0;
 			double na = o[ACC_SAMPLES], prev = o[ACC_DIFF];
 			if (accum_fold(acc, i, ACC_AA, k, mean, m2, pass))
 				continue;
@@ -327,14 +327,21 @@ static long merge_grid(struct image *acc, const struct image *img, int oy, const
 	return count;
 }
 
+/* Whether a region render of scale s may come at twice the image's size
+ * (ACC_GRID_FRAME): a grid render (scale 4 or more) or an antialiased
+ * render in scale 2's place. */
+static int may_double(int s)
+{
+	return s >= 4 || s == ACC_AA;
+}
+
 /* A region render of scale s, render_w pixels wide, of an image image_w
- * wide: its size over the image's, ACC_GRID_FRAME for a grid render (scale
- * 4 or more at twice the width), else accum_render_factor(s). */
+ * wide: its size over the image's, ACC_GRID_FRAME for one at twice the width
+ * (may_double()), else accum_render_factor(s). */
 static int render_frame(int s, int render_w, int image_w)
 {
-	return (s >= 4 || s == ACC_AA) && render_w == image_w * ACC_GRID_FRAME
-		       ? ACC_GRID_FRAME
-		       : accum_render_factor(s);
+	return may_double(s) && render_w == image_w * ACC_GRID_FRAME ? ACC_GRID_FRAME
+								     : accum_render_factor(s);
 }
 
 int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
@@ -355,7 +362,7 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 	}
 	const int f = render_frame(s, img->w, acc->w), grid = f != accum_render_factor(s);
 	if (img->w != acc->w * f) {
-		if (s >= 4 || s == ACC_AA)
+		if (may_double(s))
 			errbuf_printf(err, errlen,
 				      "the render is %d pixels wide, not %d (%d x %d) or %d (%s)",
 				      img->w, acc->w * f, acc->w, f, acc->w * ACC_GRID_FRAME,
@@ -432,7 +439,7 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 	if (folded)
 		*folded = 0;
 	int f = accum_render_factor(s), w, h;
-	if (s >= 4 || s == ACC_AA) {	/* a grid render or not: the render's width says */
+	if (may_double(s)) {	/* twice the size or not: the render's width says */
 		if (image_exr_size(path, &w, &h, err, errlen))
 			return -1;
 		f = render_frame(s, w, acc->w);

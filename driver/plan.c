@@ -875,8 +875,8 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 	if (r->scale == ACC_AA) {
 		/* POV-Ray's own adaptive antialiasing, jittered (accum.h) */
 		extra[job->nextra++] = "+AM2";
-		extra[job->nextra++] = r->aa_first ? "+A0.1" : "+A0.0";
-		extra[job->nextra++] = r->aa_first ? "+R3" : "+R4";
+		extra[job->nextra++] = r->frame > 0 ? "+A0.1" : "+A0.0";
+		extra[job->nextra++] = r->frame > 0 ? "+R3" : "+R4";
 		extra[job->nextra++] = "+J";
 	} else if (grid) {
 		/* every pixel of the render supersampled (accum.h) */

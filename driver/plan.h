@@ -82,12 +82,10 @@ struct plan_region {
 	double cost;		/* predicted cost, seconds */
 	int frame;		/* the render's size over the image's: 0 for
 				 * accum_render_factor(scale), or
-				 * ACC_GRID_FRAME for a grid render */
-	int aa_first;		/* with scale ACC_AA: the render takes scale 2's
-				 * place, at twice the image's size (frame
-				 * ACC_GRID_FRAME) with +A0.1 +R3 rather than at
-				 * its size with +A0.0 +R4 (render.c,
-				 * choose_samplers()) */
+				 * ACC_GRID_FRAME for a grid render or, with
+				 * scale ACC_AA, an antialiased render in scale
+				 * 2's place (+A0.1 +R3 rather than +A0.0 +R4;
+				 * render.c, choose_samplers()) */
 };
 
 enum plan_outcome {
@@ -140,7 +138,7 @@ void plan_release(struct plan *pl);
  * region at r->scale times base with antialiasing off; for a grid render
  * (r->frame ACC_GRID_FRAME) at twice base with +AM1 +A0.0 +R(scale/2)
  * +J0.5; when r->scale is ACC_AA at scale 1 with POV-Ray's antialiasing,
- * +AM2 +A0.0 +R4 +J, or for r->aa_first at twice the size (r->frame) with
+ * +AM2 +A0.0 +R4 +J, or at twice the size (r->frame ACC_GRID_FRAME) with
  * +AM2 +A0.1 +R3 +J (the options appended after the user's, which come
  * from base->extra).
  * base gives the scene,

@@ -635,7 +635,7 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	 * the pass at scale 2 left 3.6e-3); a --radiosity-scale stands */
 	while (r->budget > 0.0 && r->user_rad_scale < 0 && k > 2 &&
 	       elapsed(r) + radiosity_time(r, k) > r->budget)
-		k = k == 4 ? 3 : k == 3 ? 2 : k / 2;
+		k--;	/* radiosity_scale() chooses at most 4 */
 	double predicted = radiosity_time(r, k);
 	if (r->budget > 0.0 && elapsed(r) + predicted > r->budget) {
 		if (r->verbose)
@@ -809,7 +809,7 @@ static int has_scale2(const struct plan *pl)
  * The sampler of each region of a plan.  With --sampler auto, where the
  * error sits in a few pixels (plan_sparse_error()), the regions of scale 2 are
  * rendered once at twice the image's size with POV-Ray's antialiasing,
- * +AM2 +A0.1 +R3 +J (aa_first; ACC_AA_FIRST for how they are folded): it
+ * +AM2 +A0.1 +R3 +J (frame ACC_GRID_FRAME; ACC_AA_FIRST for how they are folded): it
  * subdivides only where corners differ, down to 1/16 of a pixel at a
  * highlight, where scale 2 gives every pixel of the rectangles 4 samples;
  * at twice the size its corners are scale 2's density where it does not
@@ -819,21 +819,21 @@ static int has_scale2(const struct plan *pl)
  * 3.1e-4 in 2.2 s so, where POV-Ray's own best at 2 CPU s has 4.7e-4; on the
  * scenes whose error is spread, rendering every scale-2 region so did not
  * help and under a 2 s budget was 15 to 22 times worse (see the README).
- * The antialiased regions go last (folded after the others, the same in
- * render as in regions.tsv).  Fine regions (scale 8 or 16: their pixels
- * have 21 samples or more) get resolution scaling, or with --sampler aa POV-Ray's
+ * Fine regions (scale 8 or 16: their pixels have 21 samples or more) get
+ * resolution scaling, or with --sampler aa POV-Ray's
  * own antialiasing (ACC_AA) for the regions most of whose pixels have had
  * none (once per pixel: its jitter pattern is the same every run).  The
  * antialiased regions go last, keeping their order, so that they are folded
  * after the scaled ones (their weight is measured against the means with
  * this pass's scaled samples), in render as in regions.tsv for merge.
+ * Returns how many regions take scale 2's place.
  */
-static void choose_samplers(const struct run *r, struct plan *pl)
+static size_t choose_samplers(const struct run *r, struct plan *pl)
 {
 	const int first = r->grid == PLAN_GRID_LARGE && !r->aa && has_scale2(pl) &&
 			  plan_sparse_error(r->est, (size_t)r->w * r->h);
 	if (!first && !r->aa)
-		return;
+		return 0;
 	size_t m = 0;
 	for (size_t k = 0; k < pl->nregions; k++) {
 		struct plan_region g = pl->regions[k];
@@ -845,9 +845,9 @@ static void choose_samplers(const struct run *r, struct plan *pl)
 	}
 	for (size_t k = m; k < pl->nregions; k++) {
 		pl->regions[k].scale = ACC_AA;
-		pl->regions[k].aa_first = first;
 		pl->regions[k].frame = first ? ACC_GRID_FRAME : 0;
 	}
+	return first ? pl->nregions - m : 0;
 }
 
 /*
@@ -895,7 +895,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		plan_release(&pl);
 		return PASS_STOP;
 	}
-	choose_samplers(r, &pl);
+	const size_t naa = choose_samplers(r, &pl);
 	size_t n = pl.nregions;
 	struct pov_job *jobs = calloc(n, sizeof(*jobs));
 	struct pov_region *regs = calloc(n, sizeof(*regs));
@@ -964,9 +964,6 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	double cpu_wall = (pl.cost - (double)n * r->cost_job) / (n < (size_t)r->cores ? (double)n :
 								    r->cores);
 	double guess = rounds * r->latency > cpu_wall ? rounds * r->latency : cpu_wall;
-	size_t naa = 0;
-	for (size_t k = 0; k < n; k++)
-		naa += pl.regions[k].aa_first;
 	if (naa)
 		progress(r, "pass %d: the estimated error sits in few pixels: %zu regions by "
 			 "POV-Ray's antialiasing in place of scale 2", pass, naa);

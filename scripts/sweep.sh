@@ -680,11 +680,15 @@ pp_table() {
 	file == 1 && FNR > 1 && $2 == "povpress" { pp[++np] = $0 }
 	file == 2 && FNR > 1 && $2 == "povpress" { rp[++nr] = $0 }
 	function g(x) { return sprintf("%.3g", x) }
+	# the best POV-Ray relMSE of scene sc within CPU c ("" if none), its
+	# setting in es
 	function envelope(sc, c,   j, b) {
 		b = ""
 		for (j = 1; j <= cnt[sc]; j++)
-			if (C[sc, j] <= c && (b == "" || R[sc, j] < b))
+			if (C[sc, j] <= c && (b == "" || R[sc, j] < b)) {
 				b = R[sc, j]
+				es = S[sc, j]
+			}
 		return b
 	}
 	END {
@@ -700,11 +704,10 @@ pp_table() {
 		for (k = 1; k <= np; k++) {
 			split(pp[k], f, ",")
 			sc = f[1]; c = f[4]; r = f[6]
-			be = ""; bs = "-"; fe = ""; fs = "-"
-			for (j = 1; j <= cnt[sc]; j++) {
-				if (C[sc, j] <= c && (be == "" || R[sc, j] < be)) { be = R[sc, j]; bs = S[sc, j] }
+			be = envelope(sc, c); bs = be == "" ? "-" : es
+			fe = ""; fs = "-"
+			for (j = 1; j <= cnt[sc]; j++)
 				if (R[sc, j] <= r && (fe == "" || C[sc, j] < fe)) { fe = C[sc, j]; fs = S[sc, j] }
-			}
 			ratio = be == "" ? "-" : sprintf("%.2f", r / be)
 			if (be != "" && (sc SUBSEP f[3]) in lo)
 				ratio = ratio sprintf(" (%.2f-%.2f)", lo[sc, f[3]], hi[sc, f[3]])

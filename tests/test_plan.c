@@ -1338,9 +1338,9 @@ static void test_sparse_error(void **state)
 static void test_regions_file(void **state)
 {
 	struct plan_region rs[3] = {
-		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1, 0, 0 },
-		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2, 0, 0 },
-		{ 63, 47, 63, 47, 16, 1, 0.1, 0.3, 0, 0 },
+		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1, 0 },
+		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2, 0 },
+		{ 63, 47, 63, 47, 16, 1, 0.1, 0.3, 0 },
 	};
 	static char o0[] = "r0.exr", o1[] = "a dir/with spaces/region 1.exr",
 		o2[] = "/tmp/x y  z.exr";
@@ -1428,7 +1428,7 @@ static void test_plan_job(void **state)
 {
 	static const char *const base_extra[] = { "+Q9", "Antialias_Threshold=0.1" };
 	struct pov_job base, job;
-	struct plan_region r = { 3, 2, 10, 7, 4, 0, 0.0, 0.0, 0, 0 };
+	struct plan_region r = { 3, 2, 10, 7, 4, 0, 0.0, 0.0, 0 };
 	struct pov_region region;
 	const char *extra[3];
 
@@ -1464,12 +1464,10 @@ static void test_plan_job(void **state)
 	assert_string_equal(job.extra[1], "Antialias_Threshold=0.1");
 	assert_aa_options(&job, "+AM2", "+A0.0", "+R4", "+J");
 	/* in scale 2's place: twice the size, threshold 0.1, depth 3 */
-	r.aa_first = 1;
 	r.frame = ACC_GRID_FRAME;
 	plan_job(&base, &r, "out/a1.exr", &region, aextra, &job);
 	assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
 	assert_aa_options(&job, "+AM2", "+A0.1", "+R3", "+J");
-	r.aa_first = 0;
 	r.frame = 0;
 	char name[64];
 	plan_output_name(name, sizeof(name), "w", 3, 7, ACC_AA);
