@@ -1002,12 +1002,11 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		}
 		p.regions++;
 		p.pixels += folded;
-		/* an antialiased render's samples: the camera rays POV-Ray
-		 * counted (its corners are shared between pixels) */
-		p.samples += s != ACC_AA ? (double)folded * s * s
-			     : results[k].stats.pixels > 0
-				     ? (double)(results[k].stats.pixels + results[k].stats.samples)
-				     : 0.0;
+		/* an antialiased render's samples: one per render pixel, its
+		 * subdivisions not counted (POV-Ray's statistics come after the
+		 * image, which the pool takes without waiting for them) */
+		const int f = g->frame > 0 ? g->frame : 1;
+		p.samples += (double)folded * (s != ACC_AA ? s * s : f * f);
 		if (!r->keep)
 			unlink(outs[k]);
 	}
