@@ -884,7 +884,7 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 		extra[job->nextra++] = "+A0.0";
 		int k = r->scale / s;
 		extra[job->nextra++] = k == 2 ? "+R2" : k == 4 ? "+R4" : "+R8";
-		extra[job->nextra++] = "+J0.5";
+		extra[job->nextra++] = "+J0.75";
 	} else {
 		extra[job->nextra++] = "-A";	/* our samples are the s x s grid */
 	}

@@ -137,7 +137,7 @@ void plan_release(struct plan *pl);
  * The POV-Ray job for region r of a plan, rendering into output: the
  * region at r->scale times base with antialiasing off; for a grid render
  * (r->frame ACC_GRID_FRAME) at twice base with +AM1 +A0.0 +R(scale/2)
- * +J0.5; when r->scale is ACC_AA at scale 1 with POV-Ray's antialiasing,
+ * +J0.75; when r->scale is ACC_AA at scale 1 with POV-Ray's antialiasing,
  * +AM2 +A0.0 +R4 +J, or at twice the size (r->frame ACC_GRID_FRAME) with
  * +AM2 +A0.1 +R3 +J (the options appended after the user's, which come
  * from base->extra).

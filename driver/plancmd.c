@@ -59,7 +59,7 @@ static const char plan_usage[] =
 	"                      Mpixel; render's antialiased scale 2, where the error\n"
 	"                      sits in few pixels, is render's alone), grid (twice\n"
 	"                      the size with +AM1 +A0.0\n"
-	"                      +R(scale/2) +J0.5), scale (scale times the size, no\n"
+	"                      +R(scale/2) +J0.75), scale (scale times the size, no\n"
 	"                      antialiasing) or jitter (grid, and no scale 2)\n"
 	"  --threads N         POV-Ray threads per job, +WT (default 1)\n"
 	"  --radiosity FILE    radiosity data the base pass saved (+RFO): jobs load it\n"

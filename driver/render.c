@@ -92,7 +92,7 @@ static const char usage_options[] =
 	"                        highlights, scale 2 as one render at twice the size\n"
 	"                        with POV-Ray's +AM2 +A0.1 +R3 +J), grid (scales 4, 8 and\n"
 	"                        16 as renders at twice the size with POV-Ray's +AM1\n"
-	"                        +A0.0 +R(scale/2) +J0.5: scale x scale jittered\n"
+	"                        +A0.0 +R(scale/2) +J0.75: scale x scale jittered\n"
 	"                        samples), scale (resolution scaling throughout: the\n";
 static const char usage_options2[] =
 	"                        render is scale times the size, which POV-Ray pays\n"

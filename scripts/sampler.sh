@@ -63,9 +63,9 @@ for name in "${scenes[@]}"; do
 		echo "$name,scale,$s,$c,$e" >>"$OUT/sampler.csv"
 	done
 	# grid renders (render --sampler grid): scale k at twice the size with
-	# +AM1 +A0.0 +R(k/2) +J0.5, k^2 + 4 samples per pixel
+	# +AM1 +A0.0 +R(k/2) +J0.75, k^2 + 4 samples per pixel
 	for k in 4 8 16; do
-		c=$(cpu_of povray "${common[@]}" +AM1 +A0.0 +R$((k / 2)) +J0.5 +W$((2 * W)) \
+		c=$(cpu_of povray "${common[@]}" +AM1 +A0.0 +R$((k / 2)) +J0.75 +W$((2 * W)) \
 			+H$((2 * H)) +SC$((x0 * 2 + 1)) +EC$(((x1 + 1) * 2)) +SR$((y0 * 2 + 1)) \
 			+ER$(((y1 + 1) * 2)) "+O\"$T/g.exr\"")
 		"$BOXDOWN" "$T/g.exr" 2 "$T/gd.exr" >/dev/null

@@ -1482,7 +1482,7 @@ static void test_plan_job(void **state)
 		r.frame = ACC_GRID_FRAME;
 		plan_job(&base, &r, "out/g.exr", &region, aextra, &job);
 		assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
-		assert_aa_options(&job, "+AM1", "+A0.0", s == 4 ? "+R2" : s == 8 ? "+R4" : "+R8", "+J0.5");
+		assert_aa_options(&job, "+AM1", "+A0.0", s == 4 ? "+R2" : s == 8 ? "+R4" : "+R8", "+J0.75");
 		assert_int_equal(accum_grid_samples(s), s * s + 4);
 	}
 	/* which scales are grid renders */
