@@ -93,13 +93,13 @@ static const char usage_options[] =
 	"                        with POV-Ray's +AM2 +A0.1 +R3 +J; where it is spread\n"
 	"                        and the frame at scale 4 costs less than the cores\n"
 	"                        wait on POV-Ray's latency in a pass, as jitter), grid\n"
-	"                        (scales 4, 8 and\n"
-	"                        16 as renders at twice the size with POV-Ray's +AM1\n"
-	"                        +A0.0 +R(scale/2) +J0.75: scale x scale jittered\n"
-	"                        samples), scale (resolution scaling throughout: the\n";
+	"                        (scales 4, 8 and 16 as renders at twice the size with\n"
+	"                        POV-Ray's +AM1 +A0.0 +R(scale/2) +J0.75: scale x\n"
+	"                        scale jittered samples), scale (resolution scaling\n";
 static const char usage_options2[] =
-	"                        render is scale times the size, which POV-Ray pays\n"
-	"                        for per render whatever the region), aa (scaling,\n"
+	"                        throughout: the render is scale times the size,\n"
+	"                        which POV-Ray pays for per render whatever the\n"
+	"                        region), aa (scaling,\n"
 	"                        and for pixels with 21+ samples first, once per\n"
 	"                        pixel, POV-Ray's antialiasing, +AM2 +A0 +R4 +J,\n"
 	"                        weighted by what it proves worth), or jitter (no\n"
