@@ -866,7 +866,7 @@ static size_t choose_samplers(const struct run *r, struct plan *pl)
  * POV-Ray's latency in a pass.  There a pass saved is worth more than the
  * pixels scale 2 would spare, and no regular grid of scale 2 aliases into
  * the mean: on soft_shadows at 160x120 (2026-11-22, one run each) target
- * 3e-3 reached relMSE 2.1e-4 in 0.58 CPU s, against 3.1e-4 in 0.81 s by
+ * 3e-3 reached relMSE 2.1e-4 in 0.58 CPU s, against 3.1e-4 in 0.72-0.81 s by
  * scale 2 then 4, whose regular grids alias on the far checkerboard and
  * whose difference at the horizon put the estimate at 7 times the true
  * error.  Where samples are dear (focal_blur: 1.2 CPU s for the frame at

@@ -318,6 +318,15 @@ check "... the report's sampler is still the option's" grep -q '"sampler": "auto
 check "... samples dear: the first pass renders scale 2" \
 	test -n "$(compgen -G "$T/sp-dear.exr.work/p01-*-s2.exr")"
 check "... and the report says auto" grep -q '"sampler_chosen": "auto"' "$T/sp-dear.json"
+# the choice holds for the run: a resumed run goes on without scale 2
+rs=(render "$SC/soft_shadows.pov" -o "$T/rs.exr" -W $W -H $H --cost-sample 1e-9 --target 1e-5
+	-q --keep-workdir --report "$T/rs.json")
+"$PP" "${rs[@]}" --max-passes 1 -- +WT1 &&
+	"$PP" "${rs[@]}" --max-passes 2 --resume -- +WT1 || bad "soft_shadows, resumed: render failed"
+check "... resumed, the second pass renders no scale 2 either" \
+	test -n "$(compgen -G "$T/rs.exr.work/p02-*.exr")" -a \
+	-z "$(compgen -G "$T/rs.exr.work/p*-s2.exr")"
+check "... and the report says jitter" grep -q '"sampler_chosen": "jitter"' "$T/rs.json"
 
 # --- a smooth, nearly empty scene costs almost nothing beyond the base pass --
 "$PP" render "$SC/smooth_empty.pov" -o "$T/smooth.exr" -W $W -H $H -q --report "$T/smooth.json"
