@@ -897,12 +897,6 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	pp.cost_job = r->cost_job;
 	pp.cost_sample = r->cost_sample;
 	pp.max_regions = r->jobs > 8 ? r->jobs : 8;
-	if (one_step(r)) {
-		r->jittered = 1;
-		progress(r, "pass %d: the frame at scale 4 costs less than POV-Ray's latency: "
-			 "no scale 2, scale 4 and up jittered", pass);
-	}
-	pp.grid = r->jittered ? PLAN_GRID_ONLY : r->grid;
 	/* what a pass keeps of the budget after its renders: the time of the
 	 * last analysis and 0.1 s; its renders' deadline is the rest */
 	const double reserve = r->passes[r->npasses - 1].analysis_s + 0.1;
@@ -923,6 +917,12 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		if (fit <= 2)
 			pp.fill = fit <= 1 ? pp.budget : pp.budget / fit;
 	}
+	if (one_step(r)) {
+		r->jittered = 1;
+		progress(r, "pass %d: the frame at scale 4 costs less than POV-Ray's latency: "
+			 "no scale 2, scale 4 and up jittered", pass);
+	}
+	pp.grid = r->jittered ? PLAN_GRID_ONLY : r->grid;
 	pp.min_split = r->cores;
 	struct plan pl;
 	if (plan_make_from(&r->acc, r->est, &pp, &pl, err, errlen))
