@@ -491,6 +491,13 @@ static void json_str(FILE *f, const char *s)
 	fputc('"', f);
 }
 
+/* Whether the run goes as --sampler jitter by auto's choice: the stored
+ * choice holds while --sampler is auto (a resumed run may give another). */
+static int jittered(const struct run *r)
+{
+	return r->jittered && r->grid == PLAN_GRID_LARGE && !r->aa;
+}
+
 static int write_report(struct run *r, double est, char *err, size_t errlen)
 {
 	char tmp[PATH_MAX + 16];
@@ -511,7 +518,7 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 		"  \"sampler\": \"%s\",\n  \"sampler_chosen\": \"%s\",\n  \"passes\": [\n",
 		r->cost_job, r->cost_sample, r->latency, r->radiosity ? "true" : "false",
 		r->rad_scale, r->aa ? "aa" : plan_grid_name(r->grid),
-		r->aa ? "aa" : plan_grid_name(r->jittered ? PLAN_GRID_ONLY : r->grid));
+		r->aa ? "aa" : plan_grid_name(jittered(r) ? PLAN_GRID_ONLY : r->grid));
 	for (size_t k = 0; k < r->npasses; k++) {
 		const struct pass_rec *p = &r->passes[k];
 		fprintf(f, "    {\"pass\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, "
@@ -861,7 +868,7 @@ static size_t choose_samplers(const struct run *r, struct plan *pl)
  * Whether --sampler auto should go from the base pass straight to scale 4,
  * jittered (PLAN_GRID_ONLY, as --sampler jitter), for the rest of the run:
  * at the first refinement pass, where the error is spread (not
- * plan_sparse_error()), no radiosity pass came first, and the whole frame
+ * plan_sparse_error()), the scene has no radiosity, and the whole frame
  * at scale 4, 16 samples a pixel, costs less than the cores wait on
  * POV-Ray's latency in a pass.  There a pass saved is worth more than the
  * pixels scale 2 would spare, and no regular grid of scale 2 aliases into
@@ -870,7 +877,7 @@ static size_t choose_samplers(const struct run *r, struct plan *pl)
  * scale 2 then 4, whose regular grids alias on the far checkerboard and
  * whose difference at the horizon put the estimate at 7 times the true
  * error.  Where samples are dear (focal_blur: 1.2 CPU s for the frame at
- * scale 4, 0.8 s of latency on the cores; media 4.7 s) the small step of
+ * scale 4, 0.8 s of latency on the cores; media 2.3 to 4.7 s) the small step of
  * scale 2 lets the loop stop sooner or share a budget over more pixels:
  * forced there, --budget 2 erred 2.0 (glossy_reflection) and 4.4 (media)
  * times as much.
@@ -917,12 +924,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		if (fit <= 2)
 			pp.fill = fit <= 1 ? pp.budget : pp.budget / fit;
 	}
-	if (one_step(r)) {
-		r->jittered = 1;
-		progress(r, "pass %d: the frame at scale 4 costs less than POV-Ray's latency: "
-			 "no scale 2, scale 4 and up jittered", pass);
-	}
-	pp.grid = r->jittered ? PLAN_GRID_ONLY : r->grid;
+	const int choose = !r->jittered && one_step(r);
+	pp.grid = choose || jittered(r) ? PLAN_GRID_ONLY : r->grid;
 	pp.min_split = r->cores;
 	struct plan pl;
 	if (plan_make_from(&r->acc, r->est, &pp, &pl, err, errlen))
@@ -931,6 +934,11 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		r->stop = plan_outcome_name(pl.outcome);
 		plan_release(&pl);
 		return PASS_STOP;
+	}
+	if (choose) {	/* made once a pass runs on it */
+		r->jittered = 1;
+		progress(r, "pass %d: the frame at scale 4 costs less than the cores wait on "
+			 "POV-Ray's latency: no scale 2, scale 4 and up jittered", pass);
 	}
 	const size_t naa = choose_samplers(r, &pl);
 	size_t n = pl.nregions;

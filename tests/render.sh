@@ -327,6 +327,15 @@ check "... resumed, the second pass renders no scale 2 either" \
 	test -n "$(compgen -G "$T/rs.exr.work/p02-*.exr")" -a \
 	-z "$(compgen -G "$T/rs.exr.work/p*-s2.exr")"
 check "... and the report says jitter" grep -q '"sampler_chosen": "jitter"' "$T/rs.json"
+"$PP" "${rs[@]}" --max-passes 3 --resume --sampler scale -- +WT1 ||
+	bad "soft_shadows, resumed with --sampler scale: render failed"
+check "... resumed with --sampler scale, the run goes by it" \
+	grep -q '"sampler_chosen": "scale"' "$T/rs.json"
+# a run whose first plan renders nothing (the target met) has chosen nothing
+"$PP" render "$SC/soft_shadows.pov" -o "$T/tm.exr" -W 48 -H 36 --target 0.5 --cost-sample 1e-9 \
+	-v --report "$T/tm.json" -- +WT1 2>"$T/tm.log" || bad "soft_shadows, target 0.5: render failed"
+check "... no pass, no choice: the report says auto" grep -q '"sampler_chosen": "auto"' "$T/tm.json"
+check "... and no line says otherwise" test "$(grep -c 'no scale 2' "$T/tm.log")" -eq 0
 
 # --- a smooth, nearly empty scene costs almost nothing beyond the base pass --
 "$PP" render "$SC/smooth_empty.pov" -o "$T/smooth.exr" -W $W -H $H -q --report "$T/smooth.json"
