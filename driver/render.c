@@ -159,7 +159,9 @@ struct run {
 	double user_cost_job, user_cost_sample;	/* 0: measure */
 	int user_rad_scale;	/* --radiosity-scale: -1 choose, 0 no radiosity pass */
 	int grid;		/* --sampler: which scales are grid renders,
-				 * PLAN_GRID_* (plan.h) */
+				 * PLAN_GRID_* (plan.h); PLAN_GRID_LARGE is
+				 * auto, the only one the run may change
+				 * (run_grid()) */
 	int aa;			/* --sampler aa (grid PLAN_GRID_NEVER) */
 	enum accum_final final;
 	const char *const *extra;
@@ -491,11 +493,12 @@ static void json_str(FILE *f, const char *s)
 	fputc('"', f);
 }
 
-/* Whether the run goes as --sampler jitter by auto's choice: the stored
- * choice holds while --sampler is auto (a resumed run may give another). */
-static int jittered(const struct run *r)
+/* The PLAN_GRID_* mode the run goes by: --sampler's, or PLAN_GRID_ONLY where
+ * auto chose jitter (one_step()); the stored choice holds while --sampler is
+ * auto (a resumed run may give another). */
+static int run_grid(const struct run *r)
 {
-	return r->jittered && r->grid == PLAN_GRID_LARGE && !r->aa;
+	return r->jittered && r->grid == PLAN_GRID_LARGE ? PLAN_GRID_ONLY : r->grid;
 }
 
 static int write_report(struct run *r, double est, char *err, size_t errlen)
@@ -518,7 +521,7 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 		"  \"sampler\": \"%s\",\n  \"sampler_chosen\": \"%s\",\n  \"passes\": [\n",
 		r->cost_job, r->cost_sample, r->latency, r->radiosity ? "true" : "false",
 		r->rad_scale, r->aa ? "aa" : plan_grid_name(r->grid),
-		r->aa ? "aa" : plan_grid_name(jittered(r) ? PLAN_GRID_ONLY : r->grid));
+		r->aa ? "aa" : plan_grid_name(run_grid(r)));
 	for (size_t k = 0; k < r->npasses; k++) {
 		const struct pass_rec *p = &r->passes[k];
 		fprintf(f, "    {\"pass\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, "
@@ -844,7 +847,7 @@ static int has_scale2(const struct plan *pl)
  */
 static size_t choose_samplers(const struct run *r, struct plan *pl)
 {
-	const int first = r->grid == PLAN_GRID_LARGE && !r->aa && has_scale2(pl) &&
+	const int first = r->grid == PLAN_GRID_LARGE && has_scale2(pl) &&
 			  plan_sparse_error(r->est, (size_t)r->w * r->h);
 	if (!first && !r->aa)
 		return 0;
@@ -885,7 +888,7 @@ static size_t choose_samplers(const struct run *r, struct plan *pl)
 static int one_step(const struct run *r)
 {
 	const double frame4 = 16.0 * r->cost_sample * (double)r->w * r->h;
-	return r->grid == PLAN_GRID_LARGE && !r->aa && r->npasses == 1 && !r->radiosity &&
+	return r->grid == PLAN_GRID_LARGE && r->npasses == 1 && !r->radiosity &&
 	       frame4 < r->latency * r->cores && !plan_sparse_error(r->est, (size_t)r->w * r->h);
 }
 
@@ -925,7 +928,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			pp.fill = fit <= 1 ? pp.budget : pp.budget / fit;
 	}
 	const int choose = !r->jittered && one_step(r);
-	pp.grid = choose || jittered(r) ? PLAN_GRID_ONLY : r->grid;
+	pp.grid = choose ? PLAN_GRID_ONLY : run_grid(r);
 	pp.min_split = r->cores;
 	struct plan pl;
 	if (plan_make_from(&r->acc, r->est, &pp, &pl, err, errlen))

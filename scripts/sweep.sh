@@ -350,6 +350,25 @@ echo "scene,method,setting,cpu_s,wall_s,relmse,psnr,est_relmse,capture20,oracle2
 rm -f "$RCSV" "$RCSV.tmp"
 ((REPEAT == 1)) || head -n 1 "$CSV.tmp" >"$RCSV.tmp"
 
+# awk_envelope: awk functions that median_row and pp_table share.
+# pov_run() keeps the current CSV row as a POV-Ray run of its scene;
+# envelope(sc, c) is POV-Ray's lower envelope of scene sc at CPU c, the best
+# relMSE of the runs kept that cost no more ("" if none), its setting in es.
+awk_envelope() {
+	cat <<-'EOF'
+	function pov_run(   n) { n = ++cnt[$1]; C[$1, n] = $4; R[$1, n] = $6; S[$1, n] = $2 " " $3 }
+	function envelope(sc, c,   j, b) {
+		b = ""
+		for (j = 1; j <= cnt[sc]; j++)
+			if (C[sc, j] <= c && (b == "" || R[sc, j] < b)) {
+				b = R[sc, j]
+				es = S[sc, j]
+			}
+		return b
+	}
+	EOF
+}
+
 # median_row NAME ROW...: of povpress's repeated runs (CSV rows), the one
 # whose ratio to NAME's POV-Ray lower envelope at its CPU time is the median
 # (the lower of the middle two for an even count).  NAME's POV-Ray runs are
@@ -357,12 +376,10 @@ rm -f "$RCSV" "$RCSV.tmp"
 median_row() {
 	local name=$1
 	shift
-	printf '%s\n' "$@" | awk -F, -v n="$name" '
-		NR == FNR { if ($1 == n && $2 != "povpress") { k++; C[k] = $4; R[k] = $6 }; next }
+	printf '%s\n' "$@" | awk -F, -v n="$name" "$(awk_envelope)"'
+		NR == FNR { if ($1 == n && $2 != "povpress") pov_run(); next }
 		{
-			be = ""
-			for (j = 1; j <= k; j++)
-				if (C[j] <= $4 && (be == "" || R[j] < be)) be = R[j]
+			be = envelope(n, $4)
 			m++; r[m] = be == "" || be <= 0 ? 1e300 : $6 / be; row[m] = $0
 		}
 		END {
@@ -674,23 +691,12 @@ done < <(summarize)
 pp_table() {
 	local rep=/dev/null
 	((REPEAT > 1)) && [[ -s $RCSV ]] && rep=$RCSV
-	awk -F, '
+	awk -F, "$(awk_envelope)"'
 	FNR == 1 { file++ }
-	file == 1 && FNR > 1 && $2 != "povpress" { n = ++cnt[$1]; C[$1, n] = $4; R[$1, n] = $6; S[$1, n] = $2 " " $3 }
+	file == 1 && FNR > 1 && $2 != "povpress" { pov_run() }
 	file == 1 && FNR > 1 && $2 == "povpress" { pp[++np] = $0 }
 	file == 2 && FNR > 1 && $2 == "povpress" { rp[++nr] = $0 }
 	function g(x) { return sprintf("%.3g", x) }
-	# the best POV-Ray relMSE of scene sc within CPU c ("" if none), its
-	# setting in es
-	function envelope(sc, c,   j, b) {
-		b = ""
-		for (j = 1; j <= cnt[sc]; j++)
-			if (C[sc, j] <= c && (b == "" || R[sc, j] < b)) {
-				b = R[sc, j]
-				es = S[sc, j]
-			}
-		return b
-	}
 	END {
 		for (k = 1; k <= nr; k++) {
 			split(rp[k], f, ",")

@@ -217,7 +217,7 @@ check "render: compare against a 12x12-light render" num 'a > 0' "$(cmpval "$out
 # --- the benchmark's choice among repeated runs -------------------------------
 # median_row, as scripts/sweep.sh defines it: of repeated povpress rows, the
 # one whose ratio to the scene's POV-Ray envelope (in $CSV.tmp) is the median
-eval "$(sed -n '/^median_row() {/,/^}/p' "$ROOT/scripts/sweep.sh")"
+eval "$(sed -n '/^awk_envelope() {/,/^}/p; /^median_row() {/,/^}/p' "$ROOT/scripts/sweep.sh")"
 CSV=$T/sweep.csv
 printf '%s\n' scene,method,setting,cpu_s,wall_s,relmse,psnr,est,cap,orc \
 	A,noaa,-,0.1,1,0.01,,,, A,am2,x,1.0,1,0.001,,,, B,am2,x,0.01,1,1e-9,,,, >"$CSV.tmp"

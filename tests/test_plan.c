@@ -1413,7 +1413,7 @@ static void assert_job_frame(const struct pov_job *job, const struct pov_region 
 }
 
 /* The antialiasing options a region job appends after the user's two:
- * method, threshold 0, depth, jitter. */
+ * method, threshold, depth, jitter. */
 static void assert_aa_options(const struct pov_job *job, const char *method,
 			      const char *threshold, const char *depth, const char *jitter)
 {
