@@ -669,7 +669,7 @@ static int noise_alike(const struct image *acc, size_t i)
 
 long accum_final_choose(const struct image *acc, const float *fit, const float *press,
 			const float *leverage, const double *noise, enum accum_final mode,
-			unsigned char *take, double *e)
+			float *take, double *e)
 {
 	size_t npx = (size_t)acc->w * acc->h;
 	long took = 0;
@@ -678,45 +678,53 @@ long accum_final_choose(const struct image *acc, const float *fit, const float *
 		const float *f = fit + 3 * i;
 		double n = o[ACC_SAMPLES];
 		int fin = isfinite(f[0]) && isfinite(f[1]) && isfinite(f[2]);
-		int use_fit = 0;
+		double w = 0.0;
 		if (n <= 0.0)
-			use_fit = 1;
+			w = 1.0;
 		else if (!fin || mode == ACC_FINAL_SAMPLES)
-			use_fit = 0;
+			w = 0.0;
 		else if (mode == ACC_FINAL_RECONSTRUCTION)
-			use_fit = 1;
+			w = 1.0;
 		else if (n >= 4.0 && isfinite(o[ACC_DIFF]) && isfinite(noise[i])) {
 			double h = leverage[i], p = press[i];
 			double sc = accum_error_scale(acc, i, NULL);
 			double v = mean_variance(o);
 			double u = noise[i] * sc < v ? noise[i] * sc : v;
-			if (isfinite(h) && isfinite(p) && h >= 0.0 && h <= 1.0 && u > 0.0) {
-				double bias = p - u > 0.0 ? p - u : 0.0;
-				double pred = h * h * u + (1.0 - h) * (1.0 - h) * bias;
+			if (isfinite(h) && isfinite(p) && h >= 0.0 && h < 1.0 && u > 0.0) {
+				/* b: the squared error of the fit without the
+				 * pixel, g = (fit - h Y) / (1 - h) */
+				double b = p - u > 0.0 ? p - u : 0.0;
 				double d2 = 0.0;
 				for (int c = 0; c < 3; c++)
 					d2 += ((double)f[c] - o[c]) * ((double)f[c] - o[c]) / 3.0;
-				use_fit = pred < ACC_FIT_GAIN * u && d2 <= 4.0 * u &&
-					  noise_alike(acc, i);
-				/* the pixel's error is then the fit's, unless an
-				 * edge between its samples was the larger part;
-				 * at least a quarter of the samples' (see
-				 * ACC_FIT_FLOOR) */
-				if (use_fit && e && !(e[i] > noise[i]))
+				double g2 = d2 / ((1.0 - h) * (1.0 - h));
+				if (g2 <= ACC_FIT_AGREE * (u + b) && noise_alike(acc, i)) {
+					w = u / (u + b) / (1.0 - h);
+					if (w > 1.0)
+						w = 1.0;
+				}
+				/* the blend's error, unless an edge between its
+				 * samples was the larger part; at least a quarter
+				 * of the samples' (see ACC_FIT_FLOOR) */
+				double k = w * (1.0 - h);
+				double pred = (1.0 - k) * (1.0 - k) * u + k * k * b;
+				if (w > 0.0 && e && !(e[i] > noise[i]))
 					e[i] = (pred > ACC_FIT_FLOOR * u ? pred : ACC_FIT_FLOOR * u) / sc;
 			}
 		}
-		take[i] = (unsigned char)use_fit;
-		took += use_fit;
+		take[i] = (float)w;
+		took += w > 0.0;
 	}
 	return took;
 }
 
-void accum_final_image(const struct image *acc, const float *fit, const unsigned char *take,
+void accum_final_image(const struct image *acc, const float *fit, const float *take,
 		       float *rgb)
 {
 	size_t npx = (size_t)acc->w * acc->h;
 	for (size_t i = 0; i < npx; i++)
-		for (int c = 0; c < 3; c++)
-			rgb[3 * i + c] = take[i] ? fit[3 * i + c] : acc->px[i * ACC_NCH + c];
+		for (int c = 0; c < 3; c++) {
+			double w = take[i], f = fit[3 * i + c], m = acc->px[i * ACC_NCH + c];
+			rgb[3 * i + c] = (float)(w >= 1.0 ? f : w > 0.0 ? w * f + (1.0 - w) * m : m);
+		}
 }

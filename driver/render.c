@@ -107,12 +107,12 @@ static const char usage_options2[] =
 	"                        every sample added to the base pass is jittered); see\n"
 	"                        the README\n"
 	"  --final MODE          what OUT.exr holds per pixel: auto (default: the\n"
-	"                        samples' mean, or the regression's fit where the\n"
-	"                        pixel's noise is measured, like its neighbours', and\n"
-	"                        the fit's squared error is predicted below half the\n"
-	"                        mean's), samples\n"
-	"                        (the mean of the pixel's samples), or reconstruction\n"
-	"                        (the fit everywhere); see the README\n"
+	"                        samples' mean, blended with the regression's fit\n"
+	"                        by the two's predicted errors where the pixel's\n"
+	"                        noise is measured, like its neighbours', and the\n"
+	"                        two agree), samples (the mean of the pixel's\n"
+	"                        samples), or reconstruction (the fit everywhere);\n"
+	"                        see the README\n"
 	"  -q, --quiet           no progress display\n"
 	"  -v, --verbose         progress and details, even when stderr is not a terminal\n"
 	"  -h, --help            this text\n"
@@ -185,9 +185,9 @@ struct run {
 				 * the latest analysis of acc (plan_pixel_errors()),
 				 * the fit's where the final image takes it */
 	double *noise;		/* w*h: the noise part of the samples' (ditto) */
-	unsigned char *take;	/* w*h: the final image takes the fit here
-				 * (accum_final_choose()) */
-	long took;		/* how many take it */
+	float *take;		/* w*h: the share of the fit the final image
+				 * takes (accum_final_choose()) */
+	long took;		/* how many pixels take some */
 	/* progress while a pool runs */
 	int pool_done, pool_total, pool_pass;
 };
@@ -400,8 +400,8 @@ static int stats_printed(void *arg, size_t index, const char *log)
 }
 
 /* The pixels' errors (r->est, r->noise, the image's estimate in *est) from
- * the analysis res of r->acc, and which pixels the image written takes
- * from the fit. */
+ * the analysis res of r->acc, and how much of the fit the image written
+ * takes per pixel. */
 static int estimate(struct run *r, const struct lpr_result *res, double *est, char *err,
 		    size_t errlen)
 {
@@ -1355,7 +1355,7 @@ bad:
 
 	r.est = malloc((size_t)r.w * r.h * sizeof(*r.est));
 	r.noise = malloc((size_t)r.w * r.h * sizeof(*r.noise));
-	r.take = malloc((size_t)r.w * r.h);
+	r.take = malloc((size_t)r.w * r.h * sizeof *r.take);
 	if (!r.est || !r.noise || !r.take) {
 		errbuf_printf(err, sizeof err, "out of memory");
 		goto fail;
@@ -1416,8 +1416,9 @@ bad:
 
 	/* the final image, error map and report.  The planner and the stop
 	 * went by the samples' errors; the error map and the estimate are the
-	 * final image's: under --final auto, the fit's predicted error where it
-	 * takes the fit (under --final reconstruction, still the samples') */
+	 * final image's: under --final auto, the blend's predicted error where it
+	 * takes some of the fit (under --final reconstruction, still the
+	 * samples') */
 	r.took = accum_final_choose(&r.acc, res.fit, res.error, res.leverage, r.noise, r.final,
 				    r.take, r.est);
 	double est = 0.0;
@@ -1437,7 +1438,8 @@ bad:
 			"%.1f s, %.1f CPU s; wrote %s", r.stop, r.npasses - 1, est, elapsed(&r), cpu,
 			r.out);
 		if (r.final == ACC_FINAL_AUTO)
-			fprintf(stderr, " (%ld of %d pixels from the fit)", r.took, r.w * r.h);
+			fprintf(stderr, " (%ld of %d pixels blended with the fit)", r.took,
+				r.w * r.h);
 		fputc('\n', stderr);
 	}
 	if (!r.keep && !r.user_workdir) {

@@ -1187,14 +1187,14 @@ static void test_pixel_errors(void **state)
 	image_release(&acc);
 }
 
-/* 6c. The final image's choice between a pixel's samples and the fit. */
-static int choose_centre(struct image *acc, const float *fit, float press, float lev,
-			 double noise_abs, enum accum_final mode, double *e_centre)
+/* 6c. The final image's blend of a pixel's samples and the fit: the share
+ * of the fit the centre pixel takes. */
+static double choose_centre(struct image *acc, const float *fit, float press, float lev,
+			    double noise_abs, enum accum_final mode, double *e_centre)
 {
 	enum { N = 5, C = 12 };
-	float pr[N * N], lv[N * N];
+	float pr[N * N], lv[N * N], take[N * N];
 	double noise[N * N], e[N * N];
-	unsigned char take[N * N];
 	const double sc = 0.5 * 0.5 + 0.01;
 
 	for (int i = 0; i < N * N; i++) {
@@ -1207,12 +1207,20 @@ static int choose_centre(struct image *acc, const float *fit, float press, float
 		e[C] = *e_centre;
 	long took = accum_final_choose(acc, fit, pr, lv, noise, mode, take, e);
 	long want = 0;
-	for (int i = 0; i < N * N; i++)
-		want += take[i];
+	for (int i = 0; i < N * N; i++) {
+		assert_true(take[i] >= 0.0f && take[i] <= 1.0f);
+		want += take[i] > 0.0f;
+	}
 	assert_int_equal(took, want);
 	if (e_centre)
 		*e_centre = e[C];
 	return take[C];
+}
+
+static void set_fit(float *fit, int i, float v)
+{
+	for (int c = 0; c < 3; c++)
+		fit[3 * i + c] = v;
 }
 
 static void test_final_choice(void **state)
@@ -1224,7 +1232,7 @@ static void test_final_choice(void **state)
 
 	(void)state;
 	make_acc(&acc, N, N, flat_value);
-	/* 21 samples of variance 0.21: their mean's is 0.01; a fold
+	/* 21 samples of variance 0.21: their mean's is u = 0.01; a fold
 	 * difference each */
 	for (int y = 0; y < N; y++)
 		for (int x = 0; x < N; x++)
@@ -1232,68 +1240,85 @@ static void test_final_choice(void **state)
 	for (int i = 0; i < 3 * N * N; i++)
 		fit[i] = 0.6f;	/* one standard deviation off */
 
-	/* noise: PRESS no more than the noise (no bias), leverage 0.1: the fit
-	 * is predicted to miss by 0.1^2 of the samples' 0.01, and is charged
-	 * the floor, a quarter of it */
+	/* noise: PRESS no more than the noise (the fit without the pixel is
+	 * exact, b = 0): the whole fit, predicted to miss by 0.1^2 of the
+	 * samples' 0.01, and charged the floor, a quarter of it */
 	double e = 0.01 / sc;
-	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, &e));
+	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, &e) == 1.0);
 	assert_close(e, ACC_FIT_FLOOR * 0.01 / sc, 1e-5, 0.0, "the fit's error, floored");
-	/* a bias of 0.0037: predicted 0.1^2 0.01 + 0.9^2 0.0037, above the floor */
+	/* b = 0.0037: Y + k (g - Y) with k = u / (u + b) is the fit's
+	 * k / (1 - H), and errs by u b / (u + b), above the floor */
 	e = 0.01 / sc;
-	assert_true(choose_centre(&acc, fit, 0.0137f, 0.1f, 0.01, ACC_FINAL_AUTO, &e));
-	assert_close(e, (0.1 * 0.1 * 0.01 + 0.9 * 0.9 * (0.0137 - 0.01)) / sc, 1e-5, 0.0,
-		     "the fit's error");
-	assert_false(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_SAMPLES, NULL));
-	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_RECONSTRUCTION, NULL));
+	double k = 0.01 / 0.0137;
+	assert_close(choose_centre(&acc, fit, 0.0137f, 0.1f, 0.01, ACC_FINAL_AUTO, &e),
+		     k / 0.9, 1e-5, 0.0, "the fit's share");
+	assert_close(e, 0.01 * 0.0037 / 0.0137 / sc, 1e-4, 0.0, "the blend's error");
+	/* b = 0.04, four times the samples' error: a fifth of the way */
+	e = 0.01 / sc;
+	assert_close(choose_centre(&acc, fit, 0.05f, 0.1f, 0.01, ACC_FINAL_AUTO, &e),
+		     0.2 / 0.9, 1e-5, 0.0, "the fit's share, its bias large");
+	assert_close(e, 0.01 * 0.04 / 0.05 / sc, 1e-4, 0.0, "the blend's error, bias large");
+	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_SAMPLES, NULL) == 0.0);
+	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_RECONSTRUCTION, NULL) ==
+		    1.0);
 	/* an edge between the samples was the larger part of the estimate:
 	 * the fit is taken, the estimate stays */
 	e = 0.5;
-	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, &e));
+	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, &e) == 1.0);
 	assert_true(e == 0.5);
-	/* the fit's bias: PRESS 0.05, so (1 - 0.1)^2 0.04 > 0.5 x 0.01 */
-	assert_false(choose_centre(&acc, fit, 0.05f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL));
-	/* the fit 2.5 standard deviations off */
-	for (int c = 0; c < 3; c++)
-		fit[3 * C + c] = 0.75f;
-	assert_false(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL));
-	for (int c = 0; c < 3; c++)
-		fit[3 * C + c] = 0.6f;
+	/* the fit 2.5 standard deviations off: (g - Y)^2 = 6.25 u / 0.81,
+	 * within 9 (u + b); 3.5 off, 15.1 u, not */
+	set_fit(fit, C, 0.75f);
+	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL) == 1.0);
+	set_fit(fit, C, 0.85f);
+	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL) == 0.0);
+	/* with b = 0.04 3.5 off agrees: (0.35^2 / 0.81) < 9 x 0.05 */
+	assert_true(choose_centre(&acc, fit, 0.05f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL) > 0.0);
+	set_fit(fit, C, 0.6f);
+	/* a leverage of 1: the fit is the pixel's own mean */
+	assert_true(choose_centre(&acc, fit, 0.01f, 1.0f, 0.01, ACC_FINAL_AUTO, NULL) == 0.0);
 	/* stratified samples of a detail: the fold difference says the mean
 	 * is off by 0.01, a tenth of what its sample variance says, so the fit
 	 * is 10 of its errors away (the sample variance alone would have
 	 * taken it) */
-	assert_false(choose_centre(&acc, fit, 1e-4f, 0.1f, 1e-4, ACC_FINAL_AUTO, NULL));
+	assert_true(choose_centre(&acc, fit, 1e-4f, 0.1f, 1e-4, ACC_FINAL_AUTO, NULL) == 0.0);
 	/* no fold difference: noise not measured */
 	accpx(&acc, C)[ACC_DIFF] = NAN;
-	assert_false(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL));
+	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL) == 0.0);
 	accpx(&acc, C)[ACC_DIFF] = 0.01f;
 	/* noisier than its neighbours by 16 (a highlight among dark pixels):
 	 * not theirs; by 2, alike */
 	set_px(&acc, 2, 2, 21.0f, 16 * 0.21f, 0.01f);
-	assert_false(choose_centre(&acc, fit, 0.16f, 0.1f, 0.16, ACC_FINAL_AUTO, NULL));
+	assert_true(choose_centre(&acc, fit, 0.16f, 0.1f, 0.16, ACC_FINAL_AUTO, NULL) == 0.0);
 	set_px(&acc, 2, 2, 21.0f, 2 * 0.21f, 0.01f);
-	assert_true(choose_centre(&acc, fit, 0.02f, 0.1f, 0.02, ACC_FINAL_AUTO, NULL));
+	assert_true(choose_centre(&acc, fit, 0.02f, 0.1f, 0.02, ACC_FINAL_AUTO, NULL) == 1.0);
 	/* smoother than them by 16 (the fit 0.8 of its standard deviations
 	 * off): the fit is theirs, not its; by 2, alike */
-	for (int c = 0; c < 3; c++)
-		fit[3 * C + c] = 0.52f;
+	set_fit(fit, C, 0.52f);
 	set_px(&acc, 2, 2, 21.0f, 0.21f / 16, 0.01f);
-	assert_false(choose_centre(&acc, fit, 0.01f / 16, 0.1f, 0.01 / 16, ACC_FINAL_AUTO, NULL));
+	assert_true(choose_centre(&acc, fit, 0.01f / 16, 0.1f, 0.01 / 16, ACC_FINAL_AUTO, NULL) ==
+		    0.0);
 	set_px(&acc, 2, 2, 21.0f, 0.21f / 2, 0.01f);
-	assert_true(choose_centre(&acc, fit, 0.01f / 2, 0.1f, 0.01 / 2, ACC_FINAL_AUTO, NULL));
+	assert_true(choose_centre(&acc, fit, 0.01f / 2, 0.1f, 0.01 / 2, ACC_FINAL_AUTO, NULL) ==
+		    1.0);
 	/* fewer than 4 samples keep them; none take the fit */
 	set_px(&acc, 2, 2, 2.0f, 0.21f, NAN);
-	assert_false(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL));
+	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL) == 0.0);
 	set_px(&acc, 2, 2, 0.0f, 0.0f, NAN);
-	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL));
+	assert_true(choose_centre(&acc, fit, 0.01f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL) == 1.0);
 
-	/* the image: the fit where taken, else the samples' mean */
-	unsigned char take[N * N] = {0};
-	take[3] = 1;
+	/* the image: the fit where taken, a quarter of it where a quarter is
+	 * taken, else the samples' mean */
+	float take[N * N] = {0};
+	take[3] = 1.0f;
+	take[4] = 0.25f;
 	accum_final_image(&acc, fit, take, rgb);
 	for (int i = 0; i < N * N; i++)
-		for (int c = 0; c < 3; c++)
-			assert_true(rgb[3 * i + c] == (i == 3 ? 0.6f : accpx(&acc, (size_t)i)[c]));
+		for (int c = 0; c < 3; c++) {
+			double m = accpx(&acc, (size_t)i)[c];
+			double want = i == 3 ? 0.6 : i == 4 ? 0.25 * 0.6 + 0.75 * m : m;
+			assert_close(rgb[3 * i + c], want, 1e-6, 0.0, "the final image");
+		}
 	image_release(&acc);
 }
 
