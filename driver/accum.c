@@ -691,8 +691,9 @@ long accum_final_choose(const struct image *acc, const float *fit, const float *
 			double v = mean_variance(o);
 			double u = noise[i] * sc < v ? noise[i] * sc : v;
 			if (isfinite(h) && isfinite(p) && h >= 0.0 && h < 1.0 && u > 0.0) {
-				/* b: the squared error of the fit without the
-				 * pixel, g = (fit - h Y) / (1 - h) */
+				/* b: the error of the fit without the pixel,
+				 * g = (fit - h Y) / (1 - h), as press's noise
+				 * estimate leaves it (see accum.h) */
 				double b = p - u > 0.0 ? p - u : 0.0;
 				double d2 = 0.0;
 				for (int c = 0; c < 3; c++)
@@ -713,7 +714,7 @@ long accum_final_choose(const struct image *acc, const float *fit, const float *
 			}
 		}
 		take[i] = (float)w;
-		took += w > 0.0;
+		took += take[i] > 0.0f;
 	}
 	return took;
 }

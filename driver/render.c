@@ -83,7 +83,8 @@ static const char usage_options[] =
 	"  --resume              continue the run the work directory holds\n"
 	"  --error-map FILE      error map EXR (default OUT.errors.exr): error,\n"
 	"                        relerror, samples, order, bandwidth, pass, scales,\n"
-	"                        fit (1 where OUT.exr holds the regression's fit)\n"
+	"                        fit (the share of the regression's fit OUT.exr\n"
+	"                        holds)\n"
 	"  --report FILE         JSON report of every pass (default: none)\n"
 	"  --sampler S           how pixels get their samples: auto (default: grid for\n"
 	"                        the scales whose scaled frame would exceed 1 Mpixel,\n"
@@ -183,7 +184,8 @@ struct run {
 	struct image acc;
 	double *est;		/* w*h: each pixel's estimated relative error, from
 				 * the latest analysis of acc (plan_pixel_errors()),
-				 * the fit's where the final image takes it */
+				 * the blend's where the final image takes some of
+				 * the fit */
 	double *noise;		/* w*h: the noise part of the samples' (ditto) */
 	float *take;		/* w*h: the share of the fit the final image
 				 * takes (accum_final_choose()) */

@@ -1275,7 +1275,9 @@ static void test_final_choice(void **state)
 	/* with b = 0.04 3.5 off agrees: (0.35^2 / 0.81) < 9 x 0.05 */
 	assert_true(choose_centre(&acc, fit, 0.05f, 0.1f, 0.01, ACC_FINAL_AUTO, NULL) > 0.0);
 	set_fit(fit, C, 0.6f);
-	/* a leverage of 1: the fit is the pixel's own mean */
+	/* a leverage of 1: the fit would be the pixel's own value and g
+	 * undefined; nothing is blended (the old rule took none here either,
+	 * its prediction being u) */
 	assert_true(choose_centre(&acc, fit, 0.01f, 1.0f, 0.01, ACC_FINAL_AUTO, NULL) == 0.0);
 	/* stratified samples of a detail: the fold difference says the mean
 	 * is off by 0.01, a tenth of what its sample variance says, so the fit
