@@ -248,7 +248,7 @@ enum accum_final {
  * - g and the mean agree: (g - Y)^2 is at most ACC_FIT_AGREE (u + b).
  *   press is smoothed over a neighbourhood, so at a star or a lamp among
  *   dark pixels b is the dark pixels' and k too large;
- * - its noise is like its neighbours' (within a factor 4 of their
+ * - its noise is like its neighbours' (within a factor 8 of their
  *   geometric mean): the fit is theirs too.
  * The rule before took the whole fit where its predicted error was below
  * half the mean's, and nothing elsewhere: media's image at 160x120 (one
