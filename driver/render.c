@@ -642,6 +642,10 @@ static int radiosity_scale(const struct run *r)
  * analysis of a 1920x1080 image took 1.1 to 1.4 s here on 2 cores). */
 #define RADIOSITY_RESERVE_S 0.1
 #define RADIOSITY_RESERVE_PX 7e-7
+/* and what stopping POV-Ray at the deadline takes: SIGTERM, a grace of
+ * 0.05 s, SIGKILL and the reaping (runs ended 0.02 s past the budget
+ * without it) */
+#define RADIOSITY_STOP_S 0.1
 
 /* What the radiosity pass at scale k should take, wall seconds. */
 static double radiosity_time(const struct run *r, int k)
@@ -685,7 +689,7 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	 * goes on with the base pass's samples and solution */
 	double deadline = 0.0;
 	if (r->budget > 0.0) {
-		deadline = r->budget - elapsed(r) - after;
+		deadline = r->budget - elapsed(r) - after - RADIOSITY_STOP_S;
 		if (deadline < 0.01)
 			deadline = 0.01;
 	}
@@ -709,7 +713,6 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 		p->wall_s += now_s() - t;
 		p->cpu_s += res.cpu_s;
 		p->invocations += res.attempts;
-		unlink(rad);
 		ret = 0;
 		goto out;
 	}
@@ -752,6 +755,7 @@ out:
 	image_release(&acc);
 	image_release(&img);
 	unlink(out);
+	unlink(rad);	/* renamed to r->radfile when the pass succeeded */
 	pov_result_release(&res);
 	return ret;
 }
