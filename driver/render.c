@@ -173,6 +173,7 @@ struct run {
 	double t0;
 	double prev_wall;	/* wall seconds of the passes before a resume */
 	double cost_job, cost_sample, latency;
+	double cost_sample_measured;	/* cost_sample before rounding (radiosity_time()) */
 	double tail;		/* the base pass's wait on POV-Ray's exit */
 	int radiosity;
 	int rad_scale;		/* the scale the radiosity solution was computed at */
@@ -555,19 +556,13 @@ static double quantise(double x, double anchor)
 	return anchor * exp2(round(log2(x / anchor)));
 }
 
-/* whole_frame()'s return when the render was stopped at its deadline */
-enum { FRAME_PAST_DEADLINE = 3 };
-
 /*
  * Render the whole frame at scale k (antialiasing off, POVPRESS_PASS=0) on
  * the given threads into out, saving the radiosity data to radfile: the
- * base pass and the radiosity pass.  what names it in messages.  With
- * deadline > 0, a render still running that many seconds after it began is
- * stopped.  Returns 0, -1 on failure (err says why), POV_INTERRUPTED, or
- * FRAME_PAST_DEADLINE.
+ * base pass and the radiosity pass.  what names it in messages.  Returns 0,
+ * -1 on failure (err says why), POV_INTERRUPTED.
  */
-
-static int whole_frame(struct run *r, int k, int threads, double deadline, const char *out,
+static int whole_frame(struct run *r, int k, int threads, const char *out,
 		       const char *radfile, const char *what, struct pov_result *res, char *err,
 		       size_t errlen)
 {
@@ -591,7 +586,6 @@ static int whole_frame(struct run *r, int k, int threads, double deadline, const
 	pov_pool_opts_init(&po);
 	po.max_jobs = 1;
 	po.timeout_s = r->timeout > 0 ? r->timeout : 0.0;
-	po.deadline_s = deadline;
 	double written = 0.0;
 	po.ready = note_written;
 	po.ready_log = stats_printed;
@@ -607,8 +601,6 @@ static int whole_frame(struct run *r, int k, int threads, double deadline, const
 	}
 	if (rc)
 		return -1;
-	if (res->status == POV_CANCELLED && deadline > 0.0)
-		return FRAME_PAST_DEADLINE;
 	if (res->status != POV_OK) {
 		errbuf_printf(err, errlen, "the %s of '%s' (%dx%d) failed: %s", what, r->scene,
 			      r->w * k, r->h * k, res->message);
@@ -637,22 +629,19 @@ static int radiosity_scale(const struct run *r)
 	return k;
 }
 
-/* What a budget keeps after the radiosity pass for the first analysis and
- * the image written after it: seconds, and seconds per pixel (the
- * analysis of a 1920x1080 image took 1.1 to 1.4 s here on 2 cores). */
-#define RADIOSITY_RESERVE_S 0.1
-#define RADIOSITY_RESERVE_PX 7e-7
-/* and what stopping POV-Ray at the deadline takes: SIGTERM, a grace of
- * 0.05 s, SIGKILL and the reaping (runs ended 0.02 s past the budget
- * without it) */
-#define RADIOSITY_STOP_S 0.1
-
-/* What the radiosity pass at scale k should take, wall seconds. */
+/* What the radiosity pass at scale k should take, wall seconds: by the
+ * measured cost of a sample, not the plan's rounded one, which is up to
+ * 1.4 times off either way (radiosity_room at 160x120, --budget 2: the
+ * measurement 2.65e-6 s, rounded to 1.91e-6, predicted scale 4 to fit and
+ * the run ended at 2.22 s).  The pass is not stopped at the budget's end:
+ * stopped, it leaves only the base pass's image (1.05e-2 there against
+ * scale 3's 1.63e-3), and under a reserve for the first analysis scale 3,
+ * which ends that run at 1.91 to 2.01 s, gave way to scale 2 (3.6e-3). */
 static double radiosity_time(const struct run *r, int k)
 {
 	/* a whole-frame render waits for POV-Ray's exit: the latency and the
 	 * tail the region renders do not wait on */
-	return r->latency + r->tail + r->cost_sample * k * k * (double)r->w * r->h;
+	return r->latency + r->tail + r->cost_sample_measured * k * k * (double)r->w * r->h;
 }
 
 /*
@@ -671,27 +660,15 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	 * 6.1e-3 in 0.83 to 1.1 s with the base pass's); scale 4 gives way to
 	 * 3 before 2 (POV-Ray's scale 3 alone had 1.6e-3 in 0.47 CPU s, where
 	 * the pass at scale 2 left 3.6e-3); a --radiosity-scale stands */
-	/* and the first analysis and the image written after it */
-	const double after = RADIOSITY_RESERVE_S + RADIOSITY_RESERVE_PX * (double)r->w * r->h;
 	while (r->budget > 0.0 && r->user_rad_scale < 0 && k > 2 &&
-	       elapsed(r) + radiosity_time(r, k) + after > r->budget)
+	       elapsed(r) + radiosity_time(r, k) > r->budget)
 		k--;	/* radiosity_scale() chooses at most 4 */
 	double predicted = radiosity_time(r, k);
-	if (r->budget > 0.0 && elapsed(r) + predicted + after > r->budget) {
+	if (r->budget > 0.0 && elapsed(r) + predicted > r->budget) {
 		if (r->verbose)
 			fprintf(stderr, "povpress render: no radiosity pass: it would take about "
 				"%.1f s of the %.1f s budget\n", predicted, r->budget);
 		return 0;
-	}
-	/* the budget holds when the prediction is short (radiosity_room at
-	 * 160x120, --budget 2: scale 4 predicted to end in time ended at 2.22
-	 * s): a pass still rendering at the deadline is stopped, and the run
-	 * goes on with the base pass's samples and solution */
-	double deadline = 0.0;
-	if (r->budget > 0.0) {
-		deadline = r->budget - elapsed(r) - after - RADIOSITY_STOP_S;
-		if (deadline < 0.01)
-			deadline = 0.01;
 	}
 	char out[PATH_MAX], rad[PATH_MAX + 16];
 	snprintf(out, sizeof out, "%s", wpath(r, "radiosity.exr"));
@@ -704,18 +681,7 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	/* one thread: on several POV-Ray computes another solution every run,
 	 * some much worse (radiosity_room at 640x480: relMSE 0.8e-3 to 2.6e-3
 	 * in three runs on two threads, 1.0e-3 on one; the same script) */
-	int ret = whole_frame(r, k, 1, deadline, out, rad, "radiosity pass", &res, err, errlen);
-	if (ret == FRAME_PAST_DEADLINE) {
-		if (r->verbose)
-			fprintf(stderr, "povpress render: radiosity pass stopped at the budget's "
-				"deadline (%.1f s in); the base pass's solution stays\n",
-				now_s() - t);
-		p->wall_s += now_s() - t;
-		p->cpu_s += res.cpu_s;
-		p->invocations += res.attempts;
-		ret = 0;
-		goto out;
-	}
+	int ret = whole_frame(r, k, 1, out, rad, "radiosity pass", &res, err, errlen);
 	if (ret)
 		goto out;
 	ret = -1;
@@ -755,7 +721,6 @@ out:
 	image_release(&acc);
 	image_release(&img);
 	unlink(out);
-	unlink(rad);	/* renamed to r->radfile when the pass succeeded */
 	pov_result_release(&res);
 	return ret;
 }
@@ -770,8 +735,7 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	progress(r, "base pass: %dx%d, 1 sample per pixel", r->w, r->h);
 	/* one sample at each pixel centre; radiosity, if the scene has any, is
 	 * saved for the region renders */
-	int ret = whole_frame(r, 1, r->cores, 0.0, out, r->radfile, "base pass", &res, err,
-			      errlen);
+	int ret = whole_frame(r, 1, r->cores, out, r->radfile, "base pass", &res, err, errlen);
 	if (ret)
 		goto out;
 	ret = -1;
@@ -804,6 +768,7 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	 * must not change it from run to run (--jobs 1 -- +WT1 is meant to be
 	 * reproducible): the per-sample and setup costs are rounded to powers
 	 * of two. */
+	r->cost_sample_measured = r->cost_sample;
 	r->cost_sample = quantise(r->cost_sample, 1.0);
 	/* a region render repeats the setup (parse, bounding, writing its
 	 * frame): that is its cost.  It also waits on POV-Ray's latency, but
@@ -813,7 +778,7 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	if (r->user_cost_job > 0.0)
 		r->cost_job = r->user_cost_job;
 	if (r->user_cost_sample > 0.0)
-		r->cost_sample = r->user_cost_sample;
+		r->cost_sample = r->cost_sample_measured = r->user_cost_sample;
 	struct pass_rec p = {0};
 	p.pass = 0;
 	p.wall_s = now_s() - t;
