@@ -721,6 +721,7 @@ out:
 	image_release(&acc);
 	image_release(&img);
 	unlink(out);
+	unlink(rad);	/* renamed to r->radfile when the pass succeeded */
 	pov_result_release(&res);
 	return ret;
 }
