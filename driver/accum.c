@@ -712,10 +712,11 @@ long accum_final_choose(const struct image *acc, const float *fit, const float *
 				/* the blend's error, unless an edge between its
 				 * samples was the larger part; at least a quarter
 				 * of the samples' (see ACC_FIT_FLOOR) */
-				double k = w * (1.0 - h);
-				double pred = (1.0 - k) * (1.0 - k) * u + k * k * b;
-				if (w > 0.0 && e && !(e[i] > noise[i]))
+				if (w > 0.0 && e && !(e[i] > noise[i])) {
+					double k = w * (1.0 - h);
+					double pred = (1.0 - k) * (1.0 - k) * u + k * k * b;
 					e[i] = (pred > ACC_FIT_FLOOR * u ? pred : ACC_FIT_FLOOR * u) / sc;
+				}
 			}
 		}
 		take[i] = (float)w;

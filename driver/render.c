@@ -834,6 +834,16 @@ static int has_scale2(const struct plan *pl)
 	return 0;
 }
 
+/* plan_sparse_error() of the pixels' estimate, which a pass may ask twice
+ * (one_step(), choose_samplers()): a sort of w*h values, so kept in *memo
+ * (-1 until asked) for the pass. */
+static int sparse_error(const struct run *r, int *memo)
+{
+	if (*memo < 0)
+		*memo = plan_sparse_error(r->est, (size_t)r->w * r->h);
+	return *memo;
+}
+
 /*
  * The sampler of each region of a plan.  With --sampler auto, where the
  * error sits in a few pixels (plan_sparse_error()), the regions of scale 2 are
@@ -857,10 +867,10 @@ static int has_scale2(const struct plan *pl)
  * this pass's scaled samples), in render as in regions.tsv for merge.
  * Returns how many regions take scale 2's place.
  */
-static size_t choose_samplers(const struct run *r, struct plan *pl)
+static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
 {
 	const int first = r->grid == PLAN_GRID_LARGE && has_scale2(pl) &&
-			  plan_sparse_error(r->est, (size_t)r->w * r->h);
+			  sparse_error(r, sparse);
 	if (!first && !r->aa)
 		return 0;
 	size_t m = 0;
@@ -897,11 +907,11 @@ static size_t choose_samplers(const struct run *r, struct plan *pl)
  * forced there, --budget 2 erred 2.0 (glossy_reflection) and 4.4 (media)
  * times as much.
  */
-static int one_step(const struct run *r)
+static int one_step(const struct run *r, int *sparse)
 {
 	const double frame4 = 16.0 * r->cost_sample * (double)r->w * r->h;
 	return r->grid == PLAN_GRID_LARGE && r->npasses == 1 && !r->radiosity &&
-	       frame4 < r->latency * r->cores && !plan_sparse_error(r->est, (size_t)r->w * r->h);
+	       frame4 < r->latency * r->cores && !sparse_error(r, sparse);
 }
 
 /*
@@ -939,7 +949,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		if (fit <= 2)
 			pp.fill = fit <= 1 ? pp.budget : pp.budget / fit;
 	}
-	const int choose = !r->jittered && one_step(r);
+	int sparse = -1;	/* sparse_error(), once a pass asks */
+	const int choose = !r->jittered && one_step(r, &sparse);
 	pp.grid = choose ? PLAN_GRID_ONLY : run_grid(r);
 	pp.min_split = r->cores;
 	struct plan pl;
@@ -955,7 +966,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		progress(r, "pass %d: the frame at scale 4 costs less than the cores wait on "
 			 "POV-Ray's latency: no scale 2, scale 4 and up jittered", pass);
 	}
-	const size_t naa = choose_samplers(r, &pl);
+	const size_t naa = choose_samplers(r, &pl, &sparse);
 	size_t n = pl.nregions;
 	struct pov_job *jobs = calloc(n, sizeof(*jobs));
 	struct pov_region *regs = calloc(n, sizeof(*regs));
