@@ -173,7 +173,7 @@ done
 # --- the final image: the samples' mean blended with the fit ---------------
 # glossy_reflection's work directory finished again with --final samples
 # (--target 1 renders nothing more): the blend is closer on the same samples
-# (measured 2.6e-4 against 4.2e-4; taking the whole fit where it was
+# (measured 2.5e-4 against 4.2e-4; taking the whole fit where it was
 # predicted twice as close, or nothing, 3.6e-4), and some pixels take part
 # of the fit (the error map's fit channel strictly between 0 and 1).
 if [[ -d $T/glossy_reflection.work && -f $T/glossy_reflection.exr ]]; then
