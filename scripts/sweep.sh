@@ -122,13 +122,13 @@ fi
 # centre with its base pass, so a refined pixel cannot match the reference
 # merely by sampling the same points.
 if ((quick)); then
-	REF_S=15 CHK_S=9
+	REF_S=15 CHK_S=9 TRD_S=5
 	THRESHOLDS=(0.3 0.03 0.0)
 	DEPTHS=(2 3)
 	TARGETS=(3e-3 1e-3)
 	PP_BUDGETS=(3)
 else
-	REF_S=25 CHK_S=15
+	REF_S=25 CHK_S=15 TRD_S=9
 	THRESHOLDS=(0.3 0.1 0.03 0.01 0.0)
 	DEPTHS=(2 3 4)
 	TARGETS=(3e-3 1e-3 3e-4 1e-4)
@@ -306,16 +306,41 @@ elapsed() {
 	awk -v a="$T0" -v b="$EPOCHREALTIME" 'BEGIN { printf "%.0f s", b - a }'
 }
 
-declare -A REF REFCHK REFDIFF JOBDESC
+# ref_self D1 D2: the reference's own relMSE (against the scene's true
+# image), from D1 = relMSE(ref_R, ref_C) and D2 = relMSE(ref_T, ref_C), the
+# three references at scales R > C > T.  If each one's error is independent
+# of the others' and shrinks as s^-p, D1 = e_R + e_C and D2 = e_T + e_C with
+# e_s = A s^-p: D2 / D1 fixes p (bisection on [1, 4]: 1 for errors that
+# average out slower than noise, 2 for noise, 3 for the aliasing of straight
+# edges), and e_R = D1 R^-p / (R^-p + C^-p).  Prints "e_R p", or nothing
+# where D2 / D1 lies outside what p in [1, 4] gives (as when the references
+# do not converge at all, radiosity_room's solution changing with the size):
+# then the reference's own error is not known.
+ref_self() {
+	awk -v d1="$1" -v d2="$2" -v r="$REF_S" -v c="$CHK_S" -v t="$TRD_S" '
+	function q(p) { return (c ^ -p + t ^ -p) / (r ^ -p + c ^ -p) }
+	BEGIN {
+		if (!(d1 > 0) || !(d2 > 0)) exit
+		x = d2 / d1
+		if (x < q(1) || x > q(4)) exit
+		lo = 1; hi = 4
+		for (k = 0; k < 40; k++) { m = (lo + hi) / 2; if (q(m) < x) lo = m; else hi = m }
+		p = (lo + hi) / 2
+		printf "%.3g %.2f\n", d1 * r ^ -p / (r ^ -p + c ^ -p), p
+	}'
+}
+
+declare -A REF REFCHK REFTRD REFDIFF REFSELF JOBDESC
 pending=()
-for s in "$REF_S" "$CHK_S"; do	# the larger first: better packing on the cores
+for s in "$REF_S" "$CHK_S" "$TRD_S"; do	# the larger first: better packing on the cores
 	for sc in "${scenes[@]}"; do
 		p=$(ref_path "$sc" "$s")
-		if ((s == REF_S)); then REF[$sc]=$p; else REFCHK[$sc]=$p; fi
+		if ((s == REF_S)); then REF[$sc]=$p; elif ((s == CHK_S)); then REFCHK[$sc]=$p
+		else REFTRD[$sc]=$p; fi
 		[[ -s $p ]] || pending+=("$s|$sc|$p")
 	done
 done
-echo "sweep: ${#scenes[@]} scene(s) at ${W}x$H; references (scales $REF_S and $CHK_S) in $CACHE" >&2
+echo "sweep: ${#scenes[@]} scene(s) at ${W}x$H; references (scales $REF_S, $CHK_S and $TRD_S) in $CACHE" >&2
 if ((${#pending[@]})); then
 	echo "sweep: rendering ${#pending[@]} reference(s), $NPAR at a time" >&2
 fi
@@ -339,7 +364,10 @@ while ((${#JOBS[@]})); do reap_one; done
 for sc in "${scenes[@]}"; do
 	REFDIFF[$sc]=$("$POVPRESS" compare "${REF[$sc]}" "${REFCHK[$sc]}" |
 		sed -n 's/^relmse: //p')
-	echo "sweep: $(basename "$sc" .pov): relMSE(ref$REF_S, ref$CHK_S) = ${REFDIFF[$sc]}" >&2
+	d2=$("$POVPRESS" compare "${REFTRD[$sc]}" "${REFCHK[$sc]}" | sed -n 's/^relmse: //p')
+	REFSELF[$sc]=$(ref_self "${REFDIFF[$sc]}" "$d2")
+	echo "sweep: $(basename "$sc" .pov): relMSE(ref$REF_S, ref$CHK_S) = ${REFDIFF[$sc]}," \
+		"relMSE(ref$TRD_S, ref$CHK_S) = $d2; ref$REF_S's own relMSE ${REFSELF[$sc]:-unknown}" >&2
 done
 
 # ---- the sweep
@@ -618,14 +646,17 @@ mode=full
 	echo "The no-AA CPU time is the mean of the noaa and s = 1 runs (the same render"
 	echo "twice): single measurements of renders this short vary by up to 25%, and"
 	echo "longer ones vary too, so treat a winner by less than about 1.5x as a tie."
-	echo "The reference's own error is a floor under every figure: if it shrinks as"
-	echo "1/s^2 (noise) or 1/s^3 (aliasing of edges at random angles), ref$REF_S's own relMSE"
-	echo "is about a third of relMSE(ref$REF_S, ref$CHK_S)."
+	echo "The reference's own error is a floor under every figure. \"ref$REF_S's own\" estimates"
+	echo "it from a third reference at s = $TRD_S: if the three errors are independent and"
+	echo "shrink as s^-p (p = 2 for noise, 3 for the aliasing of edges at random angles),"
+	echo "relMSE(ref$TRD_S, ref$CHK_S) / relMSE(ref$REF_S, ref$CHK_S) gives p (in parentheses) and"
+	echo "ref$REF_S's share of relMSE(ref$REF_S, ref$CHK_S); \"-\" where no p in [1, 4] fits."
 	echo
-	printf '| scene | relMSE(ref%s, ref%s) | no-AA CPU s | no-AA relMSE |' "$REF_S" "$CHK_S"
+	printf '| scene | relMSE(ref%s, ref%s) | ref%s'"'"'s own (p) | no-AA CPU s | no-AA relMSE |' \
+		"$REF_S" "$CHK_S" "$REF_S"
 	for b in "${BUDGETS[@]}"; do printf ' %sx: AA | %sx: scaling | %sx: winner |' "$b" "$b" "$b"; done
 	echo
-	printf '|---|---|---|---|'
+	printf '|---|---|---|---|---|'
 	for b in "${BUDGETS[@]}"; do printf -- '---|---|---|'; done
 	echo
 } >"$SUM"
@@ -642,7 +673,9 @@ while IFS=$'\t' read -r name ncpu nrel rest; do
 	IFS='|' read -r -a f <<<"${rest//$'\t'/|}"
 	rd=${REFDIFF[$sc]}
 	printf '%-18s %9s %6s %8s' "$name" "$(g3 "$rd")" "$ncpu" "$(g3 "$nrel")"
-	row="| $name | $(g3 "$rd") | $ncpu | $(g3 "$nrel") |"
+	own=-
+	[[ -z ${REFSELF[$sc]} ]] || own="${REFSELF[$sc]% *} (${REFSELF[$sc]#* })"
+	row="| $name | $(g3 "$rd") | $own | $ncpu | $(g3 "$nrel") |"
 	for b in "${!BUDGETS[@]}"; do
 		aa=${f[$((4 * b))]} aas=${f[$((4 * b + 1))]} sr=${f[$((4 * b + 2))]} ss=${f[$((4 * b + 3))]}
 		w=$(winner "$aa" "$sr")
@@ -675,7 +708,7 @@ while IFS=$'\t' read -r name ncpu nrel rest; do
 		if (bhalf < 1.5 * bo)
 			printf "%s: antialiasing stops improving: the AA runs above %s s CPU (the median) reach %s, the cheaper ones already %s.\n", name, amed, g(bo), g(bhalf)
 		if (bo < 4 * rd || sm < 4 * rd)
-			printf "%s: the best figures (AA %s, scale %d %s) are within 4x of relMSE(ref%d, ref%d) = %s (the reference'"'"'s own relMSE is about a third of that): they partly measure the reference.\n", name, g(bo), smax, g(sm), r, c, g(rd)
+			printf "%s: the best figures (AA %s, scale %d %s) are within 4x of relMSE(ref%d, ref%d) = %s (see the reference'"'"'s own): they partly measure the reference.\n", name, g(bo), smax, g(sm), r, c, g(rd)
 	}')
 	[[ -z $n ]] || mapfile -t -O "${#notes[@]}" notes <<<"$n"
 done < <(summarize)
@@ -691,7 +724,16 @@ done < <(summarize)
 pp_table() {
 	local rep=/dev/null
 	((REPEAT > 1)) && [[ -s $RCSV ]] && rep=$RCSV
-	awk -F, "$(awk_envelope)"'
+	local selfs="" sc
+	for sc in "${scenes[@]}"; do
+		[[ -z ${REFSELF[$sc]} ]] || selfs+="$(basename "$sc" .pov)=${REFSELF[$sc]% *};"
+	done
+	awk -F, -v selfs="$selfs" "$(awk_envelope)"'
+	BEGIN {
+		n = split(selfs, a, ";")
+		for (k = 1; k <= n; k++)
+			if (split(a[k], b, "=") == 2) own[b[1]] = b[2]
+	}
 	FNR == 1 { file++ }
 	file == 1 && FNR > 1 && $2 != "povpress" { pov_run() }
 	file == 1 && FNR > 1 && $2 == "povpress" { pp[++np] = $0 }
@@ -720,8 +762,12 @@ pp_table() {
 			speed = fe == "" ? "none reaches it" : sprintf("%.2fx (%s s, %s)", fe / c, fe, fs)
 			fid = f[8] == "" ? "-" : sprintf("%.2f / %.2f (%.0f%%)", f[9], f[10], 100 * f[9] / f[10])
 			est = f[8] == "" ? "-" : sprintf("%.2f", f[8] / r)
-			printf "| %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s |\n", sc, f[3], c, f[5],
-				g(r), be == "" ? "-" : g(be), bs, ratio, speed, est, fid
+			# against the true image: less the reference'"'"'s own error,
+			# where it is known and leaves at least a quarter
+			estx = f[8] == "" || !(sc in own) || r - own[sc] < 0.25 * r ? "-" : \
+				sprintf("%.2f", f[8] / (r - own[sc]))
+			printf "| %s | %s | %s | %s | %s | %s (%s) | %s | %s | %s | %s | %s |\n", sc, f[3], c,
+				f[5], g(r), be == "" ? "-" : g(be), bs, ratio, speed, est, estx, fid
 		}
 	}' "$CSV" "$rep"
 }
@@ -741,16 +787,18 @@ echo "$PPT" | awk -F'|' '{ printf "%-18s %-14s cpu %6s  relMSE %-9s POV-Ray %-22
 	echo "the ratio is povpress's relMSE over it (below 1 povpress wins). \"Equal-error"
 	echo "speed-up\" is the CPU of the cheapest POV-Ray run that reached povpress's relMSE"
 	echo "over povpress's CPU (above 1 povpress is faster). \"est/true\" is povpress's"
-	echo "estimated relMSE over the true one; \"capture20\" the share of the true error in"
-	echo "the 20% of pixels its error map ranks highest, next to an oracle's share."
+	echo "estimated relMSE over the true one (against the reference); \"less ref\" the same"
+	echo "with the reference's own relMSE (the table above) taken off the true one, where"
+	echo "it is known and leaves a quarter or more; \"capture20\" the share of the true"
+	echo "error in the 20% of pixels its error map ranks highest, next to an oracle's share."
 	if ((REPEAT > 1)); then
 		echo "Each setting ran $REPEAT times; the row is the run with the median ratio"
 		echo "(every run is in repeats.csv), and the ratio cell gives in parentheses the"
 		echo "lowest and highest of the runs' ratios, each at its own CPU."
 	fi
 	echo
-	echo "| scene | run | CPU s | wall s | relMSE | POV-Ray at equal CPU | ratio | equal-error speed-up | est/true | capture20 / oracle |"
-	echo "|---|---|---|---|---|---|---|---|---|---|"
+	echo "| scene | run | CPU s | wall s | relMSE | POV-Ray at equal CPU | ratio | equal-error speed-up | est/true | less ref | capture20 / oracle |"
+	echo "|---|---|---|---|---|---|---|---|---|---|---|"
 	echo "$PPT"
 } >>"$SUM"
 
