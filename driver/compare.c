@@ -31,7 +31,11 @@ static const char compare_usage[] =
 	"  est_relmse: V  the relMSE the error map predicts for IMAGE\n"
 	"  capture20: V   share of the true error in the 20% of pixels the map\n"
 	"                 ranks highest\n"
-	"  oracle20: V    the same share for a perfect ranking\n";
+	"  oracle20: V    the same share for a perfect ranking\n"
+	"  local20: V     the same share for a ranking by each pixel's 3x3\n"
+	"                 neighbourhood's mean true error (which knows where the\n"
+	"                 error lies but not how each pixel's noise fell, as the\n"
+	"                 oracle does)\n";
 
 /* Read path and reduce it to R, G, B; prints the error itself. */
 static int load_rgb(const char *path, struct image *rgb)
@@ -154,6 +158,7 @@ int cmd_compare(int argc, char **argv)
 		printf("est_relmse: %.6g\n", fd.est_relmse);
 		printf("capture20: %.4f\n", fd.capture);
 		printf("oracle20: %.4f\n", fd.oracle);
+		printf("local20: %.4f\n", fd.local);
 	}
 	if (fflush(stdout) || ferror(stdout)) {
 		fprintf(stderr, "povpress compare: cannot write output: %s\n", strerror(errno));

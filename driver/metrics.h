@@ -41,6 +41,10 @@ int metrics_compute(const struct image *img, const struct image *ref, struct met
 struct fidelity {
 	double capture;      /* share of the true error in the top 20% by estimate */
 	double oracle;       /* the same share, ranking by the true error itself */
+	double local;        /* the same share, ranking by the mean true error of
+			      * the pixel's 3 x 3 neighbourhood: a map that knows
+			      * the error where it lies but not how each pixel's
+			      * noise fell, which the oracle also ranks by */
 	double est_relmse;   /* mean estimated relMSE term */
 	double true_relmse;  /* mean true relMSE term */
 };

@@ -45,12 +45,13 @@
 # hundredths, too coarse for renders of 0.03 s); for povpress that includes
 # all its POV-Ray children.  relMSE and PSNR against the reference come from
 # `povpress compare`; for povpress also its estimated relMSE and its error
-# map's capture20 and oracle20.  The box-averaging of scale runs is not
+# map's capture20, oracle20 and local20.  The box-averaging of scale runs is not
 # counted (a few milliseconds).
 #
 # Output, in $BUILD/sweep/:
 #   sweep.csv        scene,method,setting,cpu_s,wall_s,relmse,psnr,
-#                    est_relmse,capture20,oracle20 (the last three for povpress)
+#                    est_relmse,capture20,oracle20,local20 (the last four for
+#                    povpress)
 #   repeats.csv      the same columns, every povpress run (with --repeat 2+)
 #   <scene>.png      relMSE against CPU seconds, log-log, one series per
 #                    method, povpress's runs, and POV-Ray's lower envelope
@@ -374,7 +375,7 @@ done
 
 CSV=$OUT/sweep.csv
 RCSV=$OUT/repeats.csv
-echo "scene,method,setting,cpu_s,wall_s,relmse,psnr,est_relmse,capture20,oracle20" >"$CSV.tmp"
+echo "scene,method,setting,cpu_s,wall_s,relmse,psnr,est_relmse,capture20,oracle20,local20" >"$CSV.tmp"
 rm -f "$RCSV" "$RCSV.tmp"
 ((REPEAT == 1)) || head -n 1 "$CSV.tmp" >"$RCSV.tmp"
 
@@ -481,12 +482,12 @@ for i in "${!scenes[@]}"; do
 			cmp=$("$POVPRESS" compare "$img" "${REF[$sc]}") || die "cannot compare '$img'"
 			relmse=$(sed -n 's/^relmse: //p' <<<"$cmp")
 			psnr=$(sed -n 's/^psnr: //p' <<<"$cmp")
-			fid=,,
+			fid=,,,
 			if [[ $method == povpress ]]; then
 				# the loop's own estimate, and how well its error map ranks pixels
 				cmp=$("$POVPRESS" compare "$img" "${REF[$sc]}" --analysis "${img%.exr}.errors.exr") ||
 					die "cannot judge the error map of '$img'"
-				fid="$(sed -n 's/^est_relmse: //p' <<<"$cmp"),$(sed -n 's/^capture20: //p' <<<"$cmp"),$(sed -n 's/^oracle20: //p' <<<"$cmp")"
+				fid="$(sed -n 's/^est_relmse: //p' <<<"$cmp"),$(sed -n 's/^capture20: //p' <<<"$cmp"),$(sed -n 's/^oracle20: //p' <<<"$cmp"),$(sed -n 's/^local20: //p' <<<"$cmp")"
 			fi
 			rows+=("$name,$method,$setting,$cpu,$wall,$relmse,$psnr,$fid")
 			rn=
@@ -761,6 +762,8 @@ pp_table() {
 				ratio = ratio sprintf(" (%.2f-%.2f)", lo[sc, f[3]], hi[sc, f[3]])
 			speed = fe == "" ? "none reaches it" : sprintf("%.2fx (%s s, %s)", fe / c, fe, fs)
 			fid = f[8] == "" ? "-" : sprintf("%.2f / %.2f (%.0f%%)", f[9], f[10], 100 * f[9] / f[10])
+			if (f[8] != "" && f[11] != "")
+				fid = fid sprintf(" / %.2f", f[11])
 			est = f[8] == "" ? "-" : sprintf("%.2f", f[8] / r)
 			# against the true image: less the reference'"'"'s own error,
 			# where it is known and leaves at least a quarter
@@ -790,14 +793,18 @@ echo "$PPT" | awk -F'|' '{ printf "%-18s %-14s cpu %6s  relMSE %-9s POV-Ray %-22
 	echo "estimated relMSE over the true one (against the reference); \"less ref\" the same"
 	echo "with the reference's own relMSE (the table above) taken off the true one, where"
 	echo "it is known and leaves a quarter or more; \"capture20\" the share of the true"
-	echo "error in the 20% of pixels its error map ranks highest, next to an oracle's share."
+	echo "error in the 20% of pixels its error map ranks highest, next to an oracle's share"
+	echo "(which ranks by each pixel's true error, its noise as it fell) and then the share"
+	echo "of a ranking by the mean true error of each pixel's 3x3 neighbourhood (\"local\":"
+	echo "what a map that knew where the error lies, but not how each pixel's noise fell,"
+	echo "would hold)."
 	if ((REPEAT > 1)); then
 		echo "Each setting ran $REPEAT times; the row is the run with the median ratio"
 		echo "(every run is in repeats.csv), and the ratio cell gives in parentheses the"
 		echo "lowest and highest of the runs' ratios, each at its own CPU."
 	fi
 	echo
-	echo "| scene | run | CPU s | wall s | relMSE | POV-Ray at equal CPU | ratio | equal-error speed-up | est/true | less ref | capture20 / oracle |"
+	echo "| scene | run | CPU s | wall s | relMSE | POV-Ray at equal CPU | ratio | equal-error speed-up | est/true | less ref | capture20 / oracle / local |"
 	echo "|---|---|---|---|---|---|---|---|---|---|---|"
 	echo "$PPT"
 } >>"$SUM"
