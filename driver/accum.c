@@ -488,7 +488,16 @@ static int neighbours8(const struct image *acc, size_t i, const float *q[8])
  * of width 1/(2s) next to the neighbour moves the pixel's value v by
  * alpha d, alpha uniform in [0, 1/(2s)]: the mean over alpha of
  * (alpha d)^2 / ((v + alpha d)^2 + 0.01), by the midpoint rule on 4
- * points.  The largest over the eight neighbours, mean over R, G, B.
+ * points.  The edge lies in the gap between the two pixels' samples, the
+ * neighbour's strip 1/(2 s_j) wide (s_j its finest scale): on this pixel's
+ * side with probability s_j / (s + s_j), which weighs the term.  (Charged
+ * in full to each of the two, an edge between two pixels of equal scale
+ * counted twice: hdr_highlights' estimate at --target 3e-3 was 3.1 times
+ * its true relMSE, 1.9 with the weight, the dark pixels beside its lamps
+ * near 1 each; the plans of nine scenes at targets 3e-3 to 3e-4 took 0 to
+ * 24% fewer samples to errors from 3% lower to 11% higher, a fixed cost
+ * model and one job making them deterministic.)  The largest over the
+ * eight neighbours, mean over R, G, B.
  */
 static double hidden_edge(const struct image *acc, size_t i, int s)
 {
@@ -500,6 +509,11 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 		if (!(q[ACC_SAMPLES] > 0.0f))
 			continue;
 		const int theirs = q[ACC_SAMPLES] >= 4.0f;
+		/* the edge lies in the gap between the two pixels' samples, our
+		 * strip 1/(2s) wide and theirs 1/(2 s_j): on our side with
+		 * probability s_j / (s + s_j) */
+		const int sj = finest_scale(acc, (size_t)(q - acc->px) / ACC_NCH);
+		const double share = (double)sj / (s + sj);
 		double e = 0.0;
 		for (int c = 0; c < 3; c++) {
 			double d = (double)q[c] - o[c], v = o[c];
@@ -513,6 +527,7 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 				e += m * m / ((v + m) * (v + m) + METRICS_RELMSE_EPS) / 12.0;
 			}
 		}
+		e *= share;
 		if (e > best)
 			best = e;
 	}

@@ -1165,6 +1165,41 @@ static void test_pixel_errors(void **state)
 	assert_true(accum_pixel_error(&acc, 1, 0.01, fit, accum_pixel_noise(&acc, 1, NAN)) == 0.0);
 	image_release(&acc);
 
+	/* an edge between a dark pixel and a bright one, seen by neither's
+	 * samples (no spread, no difference): the dark pixel's term is the
+	 * mean over the edge's place in its strip 1/(2s) wide (s = 4 here),
+	 * weighed by the odds that the edge lies on its side of the gap:
+	 * s_j / (s + s_j), a half for a neighbour of the same scale, two
+	 * thirds beside scale 8, a fifth beside the base pass alone */
+	make_acc(&acc, 2, 1, flat_value);
+	for (int x = 0; x < 2; x++) {
+		set_px(&acc, x, 0, 5.0f, 0.0f, 0.0f);
+		for (int c = 0; c < 3; c++)
+			accpx(&acc, (size_t)x)[c] = x ? 1.0f : 0.01f;
+	}
+	double strip = 0.0;
+	for (int k = 0; k < 4; k++) {
+		double m = (k + 0.5) / 32.0 * 0.99;
+		strip += m * m / ((0.01 + m) * (0.01 + m) + 0.01) / 4.0;
+	}
+	const float sj[3] = { 2 + 16, 2 + 256, 2 }, share[3] = { 0.5f, 2.0f / 3.0f, 0.2f };
+	accpx(&acc, 0)[ACC_SCALES] = 2 + 16;
+	for (int k = 0; k < 3; k++) {
+		accpx(&acc, 1)[ACC_SCALES] = sj[k];
+		got = accum_pixel_error(&acc, 0, 1e-6, fit, accum_pixel_noise(&acc, 0, 0.0));
+		assert_close(got, share[k] * strip, 1e-5, 0.0, "hidden edge, its share");
+	}
+	/* the pair's shares make one edge, not two */
+	accpx(&acc, 1)[ACC_SCALES] = 2 + 16;
+	double bright = accum_pixel_error(&acc, 1, 1e-6, fit, accum_pixel_noise(&acc, 1, 0.0));
+	double whole = 0.0;
+	for (int k = 0; k < 4; k++) {
+		double m = (k + 0.5) / 32.0 * -0.99;
+		whole += m * m / ((1.0 + m) * (1.0 + m) + 0.01) / 4.0;
+	}
+	assert_close(bright, 0.5 * whole, 1e-5, 0.0, "hidden edge, the bright side's half");
+	image_release(&acc);
+
 	/* a firefly: 5 samples of which one bright lifts the mean to 0.83;
 	 * the error relative to it hid how far off the pixel is */
 	make_acc(&acc, 1, 1, flat_value);
