@@ -173,8 +173,9 @@ done
 # --- the final image: the samples' mean blended with the fit ---------------
 # glossy_reflection's work directory finished again with --final samples
 # (--target 1 renders nothing more): the blend is closer on the same samples
-# (measured 2.5e-4 against 4.2e-4; taking the whole fit where it was
-# predicted twice as close, or nothing, 3.6e-4), and some pixels take part
+# (measured 2.5e-4 against 4.2e-4 with the hidden edges charged whole, 1.6e-4
+# against 3.6e-4 with them weighed; taking the whole fit where it was
+# predicted twice as close, or nothing, 3.6e-4 on the first), and some pixels take part
 # of the fit (the error map's fit channel strictly between 0 and 1).
 if [[ -d $T/glossy_reflection.work && -f $T/glossy_reflection.exr ]]; then
 	ref=$(reference "$SC/glossy_reflection.pov")
