@@ -625,7 +625,7 @@ times >"$RUNTMP/times"	# here, not in a subshell: the CPU time of the children
 TOOK="$(elapsed) wall and $(awk 'NR == 2 {
 	split($1, u, /[ms]/); split($2, s, /[ms]/)
 	printf "%.0f s", u[1] * 60 + u[2] + s[1] * 60 + s[2] }' "$RUNTMP/times") CPU (all
-processes; ${#pending[@]} of the $((2 * ${#scenes[@]})) references rendered in this run)"
+processes; ${#pending[@]} of the $((3 * ${#scenes[@]})) references rendered in this run)"
 SUM=$OUT/summary.md.tmp
 mode=full
 ((quick)) && mode=quick
