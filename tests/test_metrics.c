@@ -126,6 +126,7 @@ static void test_local_below_oracle_on_noise(void **state)
 	assert_true(f.local < 0.75 * f.oracle);
 	assert_true(f.local > 0.0);
 
+	image_release(&a);
 	make_rgb(&a, w, h, 0.5f);
 	set(&a, 7, 11, 0.9f);
 	assert_int_equal(metrics_fidelity(&a, &r, map, NULL, &f, err, sizeof(err)), 0);
