@@ -509,11 +509,6 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 		if (!(q[ACC_SAMPLES] > 0.0f))
 			continue;
 		const int theirs = q[ACC_SAMPLES] >= 4.0f;
-		/* the edge lies in the gap between the two pixels' samples, our
-		 * strip 1/(2s) wide and theirs 1/(2 s_j): on our side with
-		 * probability s_j / (s + s_j) */
-		const int sj = finest_scale(acc, (size_t)(q - acc->px) / ACC_NCH);
-		const double share = (double)sj / (s + sj);
 		double e = 0.0;
 		for (int c = 0; c < 3; c++) {
 			double d = (double)q[c] - o[c], v = o[c];
@@ -527,7 +522,13 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 				e += m * m / ((v + m) * (v + m) + METRICS_RELMSE_EPS) / 12.0;
 			}
 		}
-		e *= share;
+		if (!(e > 0.0))
+			continue;
+		/* the edge lies in the gap between the two pixels' samples, our
+		 * strip 1/(2s) wide and theirs 1/(2 s_j): on our side with
+		 * probability s_j / (s + s_j) */
+		const int sj = finest_scale(acc, (size_t)(q - acc->px) / ACC_NCH);
+		e *= (double)sj / (s + sj);
 		if (e > best)
 			best = e;
 	}

@@ -79,6 +79,21 @@ static double top_share(struct ranked *v, size_t n, double total)
 	return total > 0.0 ? s / total : 1.0;
 }
 
+/* The mean of the finite values of t (w x h) in the 3 x 3 neighbourhood
+ * of (x, y), itself included (finite). */
+static double local_mean(const double *t, int w, int h, int x, int y)
+{
+	double s = 0.0;
+	int m = 0;
+	for (int j = y > 0 ? y - 1 : 0; j <= y + 1 && j < h; j++)
+		for (int l = x > 0 ? x - 1 : 0; l <= x + 1 && l < w; l++)
+			if (isfinite(t[(size_t)j * w + l])) {
+				s += t[(size_t)j * w + l];
+				m++;
+			}
+	return s / m;
+}
+
 int metrics_fidelity(const struct image *img, const struct image *ref, const float *err_map,
 		     const struct image *fit, struct fidelity *out, char *err, size_t errlen)
 {
@@ -91,14 +106,10 @@ int metrics_fidelity(const struct image *img, const struct image *ref, const flo
 	}
 	size_t npix = (size_t)img->w * (size_t)img->h, n = 0;
 	struct ranked *v = malloc(npix * sizeof *v);
-	if (!v) {
-		if (err && errlen)
-			snprintf(err, errlen, "out of memory");
-		return -1;
-	}
-	double *tv = malloc(npix * sizeof *tv);
-	if (!tv) {
+	double *tv = malloc(npix * sizeof *tv);	/* each pixel's truth, NaN if left out */
+	if (!v || !tv) {
 		free(v);
+		free(tv);
 		if (err && errlen)
 			snprintf(err, errlen, "out of memory");
 		return -1;
@@ -137,27 +148,15 @@ int metrics_fidelity(const struct image *img, const struct image *ref, const flo
 	for (size_t i = 0; i < n; i++)
 		v[i].key = v[i].truth;
 	out->oracle = top_share(v, n, total);
-	/* ranked by the mean true error of each pixel's 3 x 3 neighbourhood
-	 * (the pixels counted above) */
+	/* the local ranking: by the mean truth of each pixel's neighbourhood */
 	size_t k = 0;
 	for (int y = 0; y < img->h; y++)
 		for (int x = 0; x < img->w; x++) {
-			double t = tv[(size_t)y * img->w + x], s = 0.0;
+			double t = tv[(size_t)y * img->w + x];
 			if (!isfinite(t))
 				continue;
-			int m = 0;
-			for (int j = y - 1; j <= y + 1; j++)
-				for (int l = x - 1; l <= x + 1; l++) {
-					if (j < 0 || j >= img->h || l < 0 || l >= img->w)
-						continue;
-					double q = tv[(size_t)j * img->w + l];
-					if (isfinite(q)) {
-						s += q;
-						m++;
-					}
-				}
 			v[k].truth = t;
-			v[k].key = s / m;
+			v[k].key = local_mean(tv, img->w, img->h, x, y);
 			k++;
 		}
 	out->local = top_share(v, k, total);

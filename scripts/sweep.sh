@@ -487,7 +487,7 @@ for i in "${!scenes[@]}"; do
 				# the loop's own estimate, and how well its error map ranks pixels
 				cmp=$("$POVPRESS" compare "$img" "${REF[$sc]}" --analysis "${img%.exr}.errors.exr") ||
 					die "cannot judge the error map of '$img'"
-				fid="$(sed -n 's/^est_relmse: //p' <<<"$cmp"),$(sed -n 's/^capture20: //p' <<<"$cmp"),$(sed -n 's/^oracle20: //p' <<<"$cmp"),$(sed -n 's/^local20: //p' <<<"$cmp")"
+				fid=$(awk '{ v[$1] = $2 } END { print v["est_relmse:"] "," v["capture20:"] "," v["oracle20:"] "," v["local20:"] }' <<<"$cmp")
 			fi
 			rows+=("$name,$method,$setting,$cpu,$wall,$relmse,$psnr,$fid")
 			rn=

@@ -175,8 +175,9 @@ done
 # (--target 1 renders nothing more): the blend is closer on the same samples
 # (measured 2.5e-4 against 4.2e-4 with the hidden edges charged whole, 1.6e-4
 # against 3.6e-4 with them weighed; taking the whole fit where it was
-# predicted twice as close, or nothing, 3.6e-4 on the first), and some pixels take part
-# of the fit (the error map's fit channel strictly between 0 and 1).
+# predicted twice as close, or nothing, 3.6e-4 on the first), and some
+# pixels take part of the fit (the error map's fit channel strictly between
+# 0 and 1).
 if [[ -d $T/glossy_reflection.work && -f $T/glossy_reflection.exr ]]; then
 	ref=$(reference "$SC/glossy_reflection.pov")
 	cp -r "$T/glossy_reflection.work" "$T/gs.work"

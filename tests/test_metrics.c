@@ -34,6 +34,17 @@ static void set(struct image *img, int x, int y, float v)
 		img->px[((size_t)y * img->w + x) * 3 + c] = v;
 }
 
+/* metrics_fidelity() of img against ref with the relative map, which must
+ * succeed. */
+static struct fidelity judge(const struct image *img, const struct image *ref, const float *map)
+{
+	struct fidelity f;
+	char err[256];
+
+	assert_int_equal(metrics_fidelity(img, ref, map, NULL, &f, err, sizeof(err)), 0);
+	return f;
+}
+
 /* One pixel off by 0.3 on a grey 0.5 frame of 4 x 4: relMSE and MSE by hand. */
 static void test_relmse_by_hand(void **state)
 {
@@ -65,7 +76,6 @@ static void test_ramp_rankings(void **state)
 	struct image a, r;
 	struct fidelity f;
 	float map[60], back[60];
-	char err[256];
 
 	make_rgb(&a, w, h, 0.5f);
 	make_rgb(&r, w, h, 0.5f);
@@ -81,13 +91,13 @@ static void test_ramp_rankings(void **state)
 			top += x >= 8 ? t : 0.0;
 			bottom += x <= 1 ? t : 0.0;
 		}
-	assert_int_equal(metrics_fidelity(&a, &r, map, NULL, &f, err, sizeof(err)), 0);
+	f = judge(&a, &r, map);
 	assert_true(fabs(f.oracle - top / total) < 1e-6);
 	assert_true(fabs(f.capture - top / total) < 1e-6);
 	assert_true(fabs(f.local - top / total) < 1e-6);
 	assert_true(fabs(f.est_relmse - total / (w * h)) < 1e-9);
 	assert_true(fabs(f.true_relmse - total / (w * h)) < 1e-9);
-	assert_int_equal(metrics_fidelity(&a, &r, back, NULL, &f, err, sizeof(err)), 0);
+	f = judge(&a, &r, back);
 	assert_true(fabs(f.capture - bottom / total) < 1e-6);
 	assert_true(fabs(f.local - top / total) < 1e-6);	/* the map plays no part */
 	image_release(&a);
@@ -110,7 +120,6 @@ static void test_local_below_oracle_on_noise(void **state)
 	struct image a, r;
 	struct fidelity f;
 	float map[400];
-	char err[256];
 
 	make_rgb(&a, w, h, 0.5f);
 	make_rgb(&r, w, h, 0.5f);
@@ -121,7 +130,7 @@ static void test_local_below_oracle_on_noise(void **state)
 			if ((hsh >> 4) % 10 < 3)
 				set(&a, x, y, 0.51f);
 		}
-	assert_int_equal(metrics_fidelity(&a, &r, map, NULL, &f, err, sizeof(err)), 0);
+	f = judge(&a, &r, map);
 	assert_true(f.oracle > 0.6);
 	assert_true(f.local < 0.75 * f.oracle);
 	assert_true(f.local > 0.0);
@@ -129,7 +138,7 @@ static void test_local_below_oracle_on_noise(void **state)
 	image_release(&a);
 	make_rgb(&a, w, h, 0.5f);
 	set(&a, 7, 11, 0.9f);
-	assert_int_equal(metrics_fidelity(&a, &r, map, NULL, &f, err, sizeof(err)), 0);
+	f = judge(&a, &r, map);
 	assert_true(fabs(f.oracle - 1.0) < 1e-9);
 	assert_true(fabs(f.local - 1.0) < 1e-9);
 	image_release(&a);
@@ -144,7 +153,6 @@ static void test_nonfinite_left_out(void **state)
 	struct image a, r;
 	struct fidelity f;
 	float map[25];
-	char err[256];
 
 	make_rgb(&a, w, h, 0.5f);
 	make_rgb(&r, w, h, 0.5f);
@@ -153,7 +161,7 @@ static void test_nonfinite_left_out(void **state)
 	set(&a, 2, 2, 0.9f);
 	map[2 * w + 2] = NAN;
 	set(&a, 0, 4, 0.6f);
-	assert_int_equal(metrics_fidelity(&a, &r, map, NULL, &f, err, sizeof(err)), 0);
+	f = judge(&a, &r, map);
 	assert_true(fabs(f.oracle - 1.0) < 1e-9);
 	assert_true(fabs(f.local - 1.0) < 1e-9);
 	double t = 0.1 * 0.1 / (0.25 + METRICS_RELMSE_EPS);
