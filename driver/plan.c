@@ -36,10 +36,6 @@ const char *plan_outcome_name(enum plan_outcome o)
 	return "?";
 }
 
-/* The largest frame a region render may have, pixels (a 4096 x 8192 frame:
- * 320x240 at scale 16, 640x480 at 8, 1920x1080 at 4). */
-#define PLAN_MAX_FRAME (32.0 * 1024 * 1024)
-
 /* The neighbourhood the fold differences are averaged over. */
 #define DIFF_RADIUS 2
 

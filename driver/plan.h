@@ -58,6 +58,9 @@ struct plan_params {
  * them, so that every sample added to the base pass is jittered. */
 enum { PLAN_GRID_NEVER, PLAN_GRID_ALWAYS, PLAN_GRID_LARGE, PLAN_GRID_ONLY };
 #define PLAN_GRID_FRAME (1024.0 * 1024.0)
+/* The largest frame a region render may have, pixels (a 4096 x 8192 frame:
+ * 320x240 at scale 16, 640x480 at 8, 1920x1080 at 4). */
+#define PLAN_MAX_FRAME (32.0 * 1024 * 1024)
 
 /* The --sampler names of PLAN_GRID_NEVER, _ALWAYS, _LARGE and _ONLY:
  * "scale", "grid", "auto", "jitter".  plan_grid_parse() returns the mode

@@ -1202,6 +1202,9 @@ struct pjob {
 	int early;		/* its output was whole before it exited: the
 				 * pool killed it */
 	int wd;			/* inotify watch of its output's directory */
+	int gate;		/* a pre-launched job's gate FIFO (O_PATH), kept
+				 * for a while after its release, or -1 */
+	double released;	/* when its gate was opened */
 	struct buf log;
 };
 
@@ -1395,6 +1398,10 @@ static int finish(struct pjob *j, const struct pov_pool_opts *opts, double t0,
 	struct stat st;
 	char pov[700];
 
+	if (j->gate >= 0) {
+		close(j->gate);
+		j->gate = -1;
+	}
 	/* The leader is a zombie, so its group id cannot be reused yet: sweep
 	 * any other member of the group before reaping. */
 	kill(-j->pid, SIGKILL);
@@ -1580,6 +1587,54 @@ static void pool_fill(struct pool *p)
 	}
 }
 
+/*
+ * Gates (pov_prelaunch_start()).  A FIFO blocks its readers' open() until a
+ * writer opens it.  POV-Ray opens its include header twice, from two
+ * threads, the second just after the first gets through; so the gate is
+ * opened by renaming an empty file over the FIFO (later opens read that)
+ * and opening the FIFO itself, through the descriptor kept of it, for
+ * writing and closing it at once: every open waiting on it returns and
+ * reads an empty header.  A reader whose open() found the FIFO just before
+ * the rename may start waiting after that: the pool opens the FIFO again at
+ * each of its checks (every 10 ms) for GATE_HOLD_S.
+ */
+#define GATE_HOLD_S 0.5
+
+static void gate_open(struct pjob *j)
+{
+#ifdef __linux__
+	char path[64];
+
+	snprintf(path, sizeof(path), "/proc/self/fd/%d", j->gate);
+	int w = open(path, O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+	if (w >= 0)
+		close(w);	/* ENXIO: no reader waits now */
+#else
+	(void)j;
+#endif
+}
+
+/* Replace the FIFO at path by an empty file; -1 if that fails (the gate
+ * is then opened only through the FIFO). */
+static int gate_replace(const char *path)
+{
+	char *tmp = xprintf("%s.open", path);
+	int rc = -1;
+
+	if (!tmp)
+		return -1;
+	unlink(tmp);
+	int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+	if (fd >= 0) {
+		close(fd);
+		rc = rename(tmp, path);
+		if (rc)
+			unlink(tmp);
+	}
+	free(tmp);
+	return rc;
+}
+
 /* Wait for output, or until the next deadline or tick, and read it. */
 static void pool_wait(struct pool *p)
 {
@@ -1604,6 +1659,16 @@ static void pool_wait(struct pool *p)
 			wait_s = j->deadline - now;
 		if (j->kill_at && !j->killed && j->kill_at - now < wait_s)
 			wait_s = j->kill_at - now;
+		if (j->gate >= 0) {
+			if (now - j->released > GATE_HOLD_S) {
+				close(j->gate);
+				j->gate = -1;
+			} else {
+				gate_open(j);
+				if (wait_s > 0.01)
+					wait_s = 0.01;
+			}
+		}
 	}
 	if (p->opts->deadline_s > 0 && !p->stopping && p->t0 + p->opts->deadline_s - now < wait_s)
 		wait_s = p->t0 + p->opts->deadline_s - now;
@@ -1665,6 +1730,220 @@ static void pool_check(struct pool *p)
 	}
 }
 
+/* ---- pre-launched renders (povray.h) ---- */
+
+static unsigned gate_serial;	/* gates' names, unique in the process */
+
+struct pov_prelaunch {
+	struct pjob *pj;	/* the jobs; pid 0 once taken or stopped */
+	size_t n, taken;
+	char **gate;		/* the gates' paths */
+	int *argc;		/* each command's length without +HI */
+	double cpu_s;		/* of the stopped ones */
+};
+
+/* Stop and reap pre-launched job k if it still runs. */
+static void prelaunch_stop(struct pov_prelaunch *pre, size_t k)
+{
+	struct pjob *j = &pre->pj[k];
+	struct rusage ru;
+	int status;
+
+	if (j->gate >= 0) {
+		close(j->gate);
+		j->gate = -1;
+	}
+	if (j->fd >= 0) {
+		close(j->fd);
+		j->fd = -1;
+	}
+	if (j->pid <= 0)
+		return;
+	kill(-j->pid, SIGKILL);
+	memset(&ru, 0, sizeof(ru));
+	while (wait4(j->pid, &status, 0, &ru) < 0 && errno == EINTR)
+		;
+	pre->cpu_s += (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
+		      (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+	j->pid = 0;
+	unlink(j->cmd.povout);
+	unlink(j->cmd.state);
+}
+
+double pov_prelaunch_end(struct pov_prelaunch *pre)
+{
+	if (!pre)
+		return 0.0;
+	for (size_t k = 0; k < pre->n; k++) {
+		prelaunch_stop(pre, k);
+		if (pre->gate && pre->gate[k]) {
+			unlink(pre->gate[k]);
+			free(pre->gate[k]);
+		}
+		cmd_release(&pre->pj[k].cmd);
+		free(pre->pj[k].bin);
+		free(pre->pj[k].log.p);
+	}
+	double cpu = pre->cpu_s;
+	free(pre->pj);
+	free(pre->gate);
+	free(pre->argc);
+	free(pre);
+	return cpu;
+}
+
+size_t pov_prelaunch_taken(const struct pov_prelaunch *pre)
+{
+	return pre ? pre->taken : 0;
+}
+
+int pov_prelaunch_start(const struct pov_job *jobs, size_t njobs, const char *gatedir,
+			struct pov_prelaunch **out, char *err, size_t errlen)
+{
+	char bin[PATH_MAX];
+	struct pov_result res;
+	int devnull = -1;
+
+	*out = NULL;
+#ifndef __linux__
+	(void)jobs;
+	(void)njobs;
+	(void)gatedir;
+	(void)bin;
+	(void)res;
+	(void)devnull;
+	errbuf_printf(err, errlen, "pre-launched renders need Linux");
+	return -1;
+#else
+	if (!pov_path_safe(gatedir)) {
+		errbuf_printf(err, errlen, "cannot pre-launch renders: unsafe directory '%s'",
+			      gatedir);
+		return -1;
+	}
+	struct pov_prelaunch *pre = calloc(1, sizeof(*pre));
+	if (!pre || !(pre->pj = calloc(njobs ? njobs : 1, sizeof(*pre->pj))) ||
+	    !(pre->gate = calloc(njobs ? njobs : 1, sizeof(*pre->gate))) ||
+	    !(pre->argc = calloc(njobs ? njobs : 1, sizeof(*pre->argc)))) {
+		if (pre) {
+			free(pre->pj);
+			free(pre->gate);
+		}
+		free(pre);
+		errbuf_printf(err, errlen, "out of memory");
+		return -1;
+	}
+	pre->n = njobs;
+	for (size_t k = 0; k < njobs; k++) {
+		pre->pj[k].fd = -1;
+		pre->pj[k].gate = -1;
+	}
+	devnull = open("/dev/null", O_RDWR | O_CLOEXEC);
+	if (devnull >= 0)
+		devnull = high_fd(devnull);
+	if (devnull < 0) {
+		errbuf_printf(err, errlen, "cannot open '/dev/null': %s", strerror(errno));
+		goto fail;
+	}
+	for (size_t k = 0; k < njobs; k++) {
+		struct pjob *j = &pre->pj[k];
+
+		if (pov_find_binary(&jobs[k], bin, sizeof(bin), err, errlen) ||
+		    cmd_build(&jobs[k], &j->cmd, err, errlen))
+			goto fail;
+		pre->argc[k] = j->cmd.argc;
+		pre->gate[k] = xprintf("%s/gate-%u.inc", gatedir, ++gate_serial);
+		j->bin = strdup(bin);
+		if (!pre->gate[k] || !j->bin ||
+		    cmd_push(&j->cmd, xprintf("+HI\"%s\"", pre->gate[k]))) {
+			errbuf_printf(err, errlen, "out of memory");
+			goto fail;
+		}
+		unlink(pre->gate[k]);
+		if (mkfifo(pre->gate[k], 0600)) {
+			errbuf_printf(err, errlen, "cannot make the FIFO '%s': %s", pre->gate[k],
+				      strerror(errno));
+			goto fail;
+		}
+		j->gate = open(pre->gate[k], O_PATH | O_CLOEXEC);
+		if (j->gate < 0) {
+			errbuf_printf(err, errlen, "cannot open the FIFO '%s': %s", pre->gate[k],
+				      strerror(errno));
+			goto fail;
+		}
+		memset(&res, 0, sizeof(res));
+		if (spawn(j, devnull, now_s(), &res)) {
+			errbuf_printf(err, errlen, "%s", res.message);
+			goto fail;
+		}
+	}
+	close(devnull);
+	*out = pre;
+	return 0;
+fail:
+	if (devnull >= 0)
+		close(devnull);
+	pov_prelaunch_end(pre);
+	return -1;
+#endif
+}
+
+/* Whether pre-launched job k's command, the gate aside, is c. */
+static int prelaunch_matches(const struct pov_prelaunch *pre, size_t k, const struct cmd *c)
+{
+	const struct cmd *q = &pre->pj[k].cmd;
+
+	if (pre->pj[k].pid <= 0 || pre->argc[k] != c->argc)
+		return 0;
+	for (int i = 0; i < c->argc; i++)
+		if (strcmp(q->argv[i], c->argv[i]))
+			return 0;
+	return 1;
+}
+
+/* Take the pre-launched jobs that match pool jobs (their commands built),
+ * stop the rest.  The taken ones are released when the run begins. */
+static void prelaunch_take(struct pool *p, struct pov_prelaunch *pre)
+{
+	for (size_t i = 0; i < p->n; i++) {
+		for (size_t k = 0; k < pre->n; k++) {
+			if (!prelaunch_matches(pre, k, &p->pj[i].cmd))
+				continue;
+			struct pjob *j = &p->pj[i];
+			cmd_release(&j->cmd);
+			free(j->bin);
+			*j = pre->pj[k];
+			memset(&pre->pj[k], 0, sizeof(pre->pj[k]));
+			pre->pj[k].fd = -1;
+			pre->pj[k].gate = -1;
+			j->state = J_RUNNING;
+			gate_replace(pre->gate[k]);
+			p->res[i].prelaunched = 1;
+			pre->taken++;
+			break;
+		}
+	}
+	for (size_t k = 0; k < pre->n; k++)
+		prelaunch_stop(pre, k);
+}
+
+/* Begin the taken jobs: open their gates. */
+static void prelaunch_begin(struct pool *p)
+{
+	for (size_t i = 0; i < p->n; i++) {
+		struct pjob *j = &p->pj[i];
+
+		if (!p->res[i].prelaunched)
+			continue;
+		j->start = j->released = now_s();
+		j->deadline = j->start + p->opts->timeout_s;
+		p->res[i].attempts = 1;
+		p->res[i].start_s = j->start - p->t0;
+		p->running++;
+		if (j->gate >= 0)
+			gate_open(j);
+	}
+}
+
 int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool_opts *opts,
 		 struct pov_result *results, char *err, size_t errlen)
 {
@@ -1692,6 +1971,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 	/* Everything that can be checked is checked before anything starts. */
 	for (size_t i = 0; i < njobs; i++) {
 		p.pj[i].fd = -1;
+		p.pj[i].gate = -1;
 		if (pov_find_binary(&jobs[i], bin, sizeof(bin), err, errlen) ||
 		    cmd_build(&jobs[i], &p.pj[i].cmd, err, errlen))
 			goto out;
@@ -1701,6 +1981,8 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 			goto out;
 		}
 	}
+	if (opts->prelaunched)
+		prelaunch_take(&p, opts->prelaunched);
 	/* Outputs seen whole before POV-Ray exits (where inotify works). */
 #ifdef __linux__
 	if (opts->ready && njobs) {
@@ -1743,6 +2025,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 	}
 
 	p.t0 = now_s();
+	prelaunch_begin(&p);
 	while (1) {
 		if (p.stopping != STOP_CANCEL && pov_signal_received())
 			pool_stop(&p, STOP_CANCEL, opts->grace_s);
@@ -1790,6 +2073,15 @@ out:
 		close(p.ino);
 	if (p.pj) {
 		for (size_t i = 0; i < njobs; i++) {
+			if (p.pj[i].gate >= 0)
+				close(p.pj[i].gate);
+			if (p.pj[i].pid > 0) {	/* taken, but the run failed before it began */
+				kill(-p.pj[i].pid, SIGKILL);
+				while (waitpid(p.pj[i].pid, NULL, 0) < 0 && errno == EINTR)
+					;
+			}
+			if (p.pj[i].fd >= 0)
+				close(p.pj[i].fd);
 			cmd_release(&p.pj[i].cmd);
 			free(p.pj[i].bin);
 			free(p.pj[i].log.p);

@@ -21,6 +21,7 @@
 #include "driver/povray.h"
 #include "regression/lpr.h"
 
+#include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
 #include <limits.h>
@@ -38,6 +39,7 @@
 static const char usage[] =
 	"usage: povpress render SCENE.pov -o OUT.exr [-W w] [-H h] [--target RELMSE]\n"
 	"                       [--budget SECONDS] [--max-passes N] [--jobs N]\n"
+	"                       [--prelaunch auto|on|off]\n"
 	"                       [--workdir DIR] [--keep-workdir] [--resume]\n"
 	"                       [--error-map FILE] [--report FILE.json]\n"
 	"                       [--final auto|samples|reconstruction] [--radiosity-scale K]\n"
@@ -64,6 +66,12 @@ static const char usage_options[] =
 	"                        region renders still running when only the last\n"
 	"                        analysis's time is left are stopped)\n"
 	"  --max-passes N        refinement passes after the base pass (default 8)\n"
+	"  --prelaunch auto|on|off\n"
+	"                        start the first pass's likely region renders with\n"
+	"                        the base pass, waiting before the scene, and let\n"
+	"                        that pass take the ones its plan matches: saves\n"
+	"                        POV-Ray's start-up wait (about 0.3 s) once (auto,\n"
+	"                        the default: under a --budget)\n"
 	"  --jobs N              POV-Ray processes at once (default 4 per core: each\n"
 	"                        invocation waits 0.3 to 0.7 s on POV-Ray itself)\n"
 	"  --timeout SECONDS     per POV-Ray run; one retry after a crash or timeout\n"
@@ -139,6 +147,12 @@ static double self_cpu(void)
 	       ru.ru_stime.tv_usec * 1e-6;
 }
 
+/* --prelaunch */
+enum { PRE_OFF, PRE_AUTO, PRE_ON };
+#define PRE_KINDS 3	/* scale 2, scale 4 as a grid render, antialiased */
+#define PRE_BANDS 8
+#define PRE_MAX (PRE_KINDS * PRE_BANDS)
+
 struct pass_rec {
 	int pass;
 	double wall_s, cpu_s, driver_cpu_s;
@@ -147,6 +161,7 @@ struct pass_rec {
 	double samples;
 	double est_relmse;
 	double analysis_s;
+	int prelaunched;	/* regions taken from renders started early */
 };
 
 struct run {
@@ -164,6 +179,7 @@ struct run {
 				 * auto, the only one the run may change
 				 * (run_grid()) */
 	int aa;			/* --sampler aa (grid PLAN_GRID_NEVER) */
+	int prelaunch;		/* --prelaunch: PRE_AUTO, PRE_ON, PRE_OFF */
 	enum accum_final final;
 	const char *const *extra;
 	size_t nextra;
@@ -193,6 +209,11 @@ struct run {
 	long took;		/* how many pixels take some */
 	/* progress while a pool runs */
 	int pool_done, pool_total, pool_pass;
+	/* the next pass's guessed renders, started early (--prelaunch) */
+	struct pov_prelaunch *pre;
+	struct plan_region pre_reg[PRE_MAX];
+	size_t npre;
+	int pre_pass;		/* the pass they are for */
 };
 
 static void print_usage(FILE *f)
@@ -521,19 +542,21 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 	json_str(f, r->stop ? r->stop : "");
 	fprintf(f, ",\n  \"cost_model\": {\"job_s\": %.17g, \"sample_s\": %.17g, "
 		"\"latency_s\": %.6g},\n  \"radiosity\": %s,\n  \"radiosity_scale\": %d,\n"
-		"  \"sampler\": \"%s\",\n  \"sampler_chosen\": \"%s\",\n  \"passes\": [\n",
+		"  \"sampler\": \"%s\",\n  \"sampler_chosen\": \"%s\",\n  \"prelaunch\": \"%s\",\n"
+		"  \"passes\": [\n",
 		r->cost_job, r->cost_sample, r->latency, r->radiosity ? "true" : "false",
 		r->rad_scale, r->aa ? "aa" : plan_grid_name(r->grid),
-		r->aa ? "aa" : plan_grid_name(run_grid(r)));
+		r->aa ? "aa" : plan_grid_name(run_grid(r)),
+		r->prelaunch == PRE_ON ? "on" : r->prelaunch == PRE_OFF ? "off" : "auto");
 	for (size_t k = 0; k < r->npasses; k++) {
 		const struct pass_rec *p = &r->passes[k];
 		fprintf(f, "    {\"pass\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, "
 			"\"driver_cpu_s\": %.3f, \"invocations\": %d, \"regions\": %d, "
 			"\"failed\": %d, \"pixels\": %ld, \"samples\": %.0f, "
-			"\"est_relmse\": %.6g, \"analysis_s\": %.3f}%s\n",
+			"\"est_relmse\": %.6g, \"analysis_s\": %.3f, \"prelaunched\": %d}%s\n",
 			p->pass, p->wall_s, p->cpu_s, p->driver_cpu_s, p->invocations, p->regions,
 			p->failed, p->pixels, p->samples, p->est_relmse, p->analysis_s,
-			k + 1 < r->npasses ? "," : "");
+			p->prelaunched, k + 1 < r->npasses ? "," : "");
 		tw += p->wall_s;
 		tc += p->cpu_s;
 		td += p->driver_cpu_s;
@@ -726,6 +749,254 @@ out:
 	return ret;
 }
 
+/*
+ * --prelaunch.  POV-Ray waits about 0.3 s on itself before it reads the
+ * scene (povray.h, pov_prelaunch_start()), and every region render of a
+ * pass with it.  A pass's renders can be started before its plan exists,
+ * during the pass before (the base pass for the first), if they are
+ * guessed: bands of whole rows of one kind of render (a scale and whether
+ * it is a grid render, or POV-Ray's antialiasing in scale 2's place), each
+ * waiting at its gate.  A pass takes the bands of its main kind (the most
+ * pixels) that its regions of that kind touch, when they cost at most half
+ * a latency on the cores more than those regions (prelaunch_cover()), and
+ * leaves its other regions to the next pass; the rest are stopped, having
+ * used about 0.01 CPU s each.  The first pass's guesses: each kind the
+ * sampler allows (scale 2 over the frame where samples are dear; scale 4 as
+ * a grid render where --sampler auto goes straight to it; antialiasing
+ * where the error sits in few pixels), in min(cores, jobs) bands; a later
+ * pass's: the next scale of the pass before's main kind, in twice as many.
+ */
+static int ci_at(const char *a, const char *lower)
+{
+	for (; *lower; a++, lower++)
+		if (tolower((unsigned char)*a) != *lower)
+			return 0;
+	return 1;
+}
+
+static int is_user_header(const char *a)
+{
+	size_t n = strlen(a);
+	if ((a[0] == '+' || a[0] == '-') && ci_at(a + 1, "hi"))
+		return 1;
+	for (size_t i = 0; i + 14 <= n; i++)
+		if (ci_at(a + i, "include_header"))
+			return 1;
+	return n > 4 && ci_at(a + n - 4, ".ini");
+}
+
+struct pre_kind {
+	int scale, frame;
+};
+
+/* Whether region g is of kind k (frame 0 or ACC_GRID_FRAME alike). */
+static int of_kind(const struct plan_region *g, struct pre_kind k)
+{
+	return g->scale == k.scale && (g->frame > 0) == (k.frame > 0);
+}
+
+/* Start nb bands of each of the nk kinds for pass `pass` (r->pre). */
+static void prelaunch_start(struct run *r, int pass, const struct pre_kind *kinds, int nk, int nb)
+{
+	if (r->prelaunch == PRE_OFF || (r->prelaunch == PRE_AUTO && !(r->budget > 0.0)) ||
+	    r->pre || nk < 1)
+		return;
+	for (size_t k = 0; k < r->nextra; k++)
+		if (is_user_header(r->extra[k]))
+			return;	/* its header or an INI file that may set one: the
+				 * gate would take its place */
+	if (nk > PRE_KINDS)
+		nk = PRE_KINDS;
+	if (nb > r->jobs)
+		nb = r->jobs;
+	if (nb > PRE_BANDS)
+		nb = PRE_BANDS;
+	if (nb > r->h)
+		nb = r->h;
+	if (nb < 1)
+		nb = 1;
+	struct pov_job jobs[PRE_MAX];
+	struct pov_region regs[PRE_MAX];
+	char outs[PRE_MAX][PATH_MAX];
+	const char **extras = calloc((size_t)PRE_MAX * (r->nextra + 4) + r->nextra + 4,
+				     sizeof(char *));
+	if (!extras)
+		return;
+	const char **bextra = extras + (size_t)PRE_MAX * (r->nextra + 4);
+	struct pov_job base;
+	base_job(r, &base, bextra, 1);
+	char passno[16];
+	snprintf(passno, sizeof passno, "%d", pass);
+	const struct pov_define pd = { "POVPRESS_PASS", passno };
+	base.defines = &pd;
+	base.ndefines = 1;
+	size_t n = 0;
+	for (int t = 0; t < nk; t++) {
+		for (int b = 0; b < nb; b++) {
+			struct plan_region *g = &r->pre_reg[n];
+			memset(g, 0, sizeof(*g));
+			g->x0 = 0;
+			g->x1 = r->w - 1;
+			g->y0 = (int)((long)b * r->h / nb);
+			g->y1 = (int)((long)(b + 1) * r->h / nb) - 1;
+			g->scale = kinds[t].scale;
+			g->frame = kinds[t].frame;
+			plan_output_name(outs[n], sizeof outs[n], r->workdir, pass, n, g->scale);
+			plan_job(&base, g, outs[n], &regs[n], extras + n * (r->nextra + 4), &jobs[n]);
+			n++;
+		}
+	}
+	char err[512];
+	if (pov_prelaunch_start(jobs, n, r->povdir, &r->pre, err, sizeof err) == 0) {
+		r->npre = n;
+		r->pre_pass = pass;
+	} else if (r->verbose) {
+		fprintf(stderr, "povpress render: no renders started early: %s\n", err);
+	}
+	free(extras);
+}
+
+/* The first pass's guesses, started with the base pass. */
+static void prelaunch_first(struct run *r)
+{
+	struct pre_kind kinds[PRE_KINDS];
+	int nk = 0;
+	if (r->grid != PLAN_GRID_ONLY)
+		kinds[nk++] = (struct pre_kind){ 2, 0 };
+	if (r->grid != PLAN_GRID_NEVER)
+		kinds[nk++] = (struct pre_kind){ 4, ACC_GRID_FRAME };
+	if (r->grid == PLAN_GRID_LARGE && !r->aa)
+		kinds[nk++] = (struct pre_kind){ ACC_AA, ACC_GRID_FRAME };
+	prelaunch_start(r, 1, kinds, nk, r->cores);
+}
+
+/* The next pass's guess from this pass's plan pl (pp its parameters): the
+ * scale after its main kind's. */
+static void prelaunch_next(struct run *r, int pass, const struct plan *pl,
+			   const struct plan_params *pp)
+{
+	struct pre_kind best = { 0, 0 };
+	long best_area = 0;
+	for (size_t k = 0; k < pl->nregions; k++) {
+		const struct plan_region *g = &pl->regions[k];
+		struct pre_kind kind = { g->scale, g->frame };
+		long area = 0;
+		for (size_t j = 0; j < pl->nregions; j++)
+			if (of_kind(&pl->regions[j], kind))
+				area += (long)(pl->regions[j].x1 - pl->regions[j].x0 + 1) *
+					(pl->regions[j].y1 - pl->regions[j].y0 + 1);
+		if (area > best_area) {
+			best_area = area;
+			best = kind;
+		}
+	}
+	int s = best.scale == ACC_AA ? 4 : 2 * best.scale;
+	if (!best_area || s > accum_scales[ACC_NSCALES - 1])
+		return;
+	struct plan_params next = *pp;
+	next.grid = run_grid(r);
+	struct pre_kind kind = { s, plan_grid_scale(&next, r->w, r->h, s) ? ACC_GRID_FRAME : 0 };
+	if (!kind.frame && (double)s * s * r->w * r->h > PLAN_MAX_FRAME)
+		return;	/* a frame no region render gets */
+	prelaunch_start(r, pass, &kind, 1, 2 * r->cores);
+}
+
+/* Stop the early renders none took; their CPU goes to pass record p. */
+static void prelaunch_end(struct run *r, struct pass_rec *p)
+{
+	if (!r->pre)
+		return;
+	double cpu = pov_prelaunch_end(r->pre);
+	if (p)
+		p->cpu_s += cpu;
+	r->pre = NULL;
+	r->npre = 0;
+}
+
+/*
+ * Whether plan pl of pass `pass` takes early renders: its main kind of
+ * region is one of them, and the bands of that kind its regions touch cost
+ * at most half a latency on the cores more than those regions (a pixel
+ * costing what it costs in them).  Then pl's regions become those bands,
+ * each with its index in r->pre_reg in idx[], and the count is returned;
+ * else 0 and pl is unchanged.
+ */
+static size_t prelaunch_cover(struct run *r, int pass, struct plan *pl, size_t **idx)
+{
+	*idx = NULL;
+	if (!r->pre || r->pre_pass != pass || !pl->nregions)
+		return 0;
+	struct pre_kind K = { 0, 0 };
+	long area = 0;
+	double cost = 0.0;
+	int nk = 0;
+	for (size_t k = 0; k < pl->nregions; k++) {
+		struct pre_kind kind = { pl->regions[k].scale, pl->regions[k].frame };
+		long a = 0;
+		double c = 0.0;
+		int n = 0;
+		for (size_t j = 0; j < pl->nregions; j++) {
+			const struct plan_region *g = &pl->regions[j];
+			if (!of_kind(g, kind))
+				continue;
+			a += (long)(g->x1 - g->x0 + 1) * (g->y1 - g->y0 + 1);
+			c += g->cost;
+			n++;
+		}
+		if (a > area) {
+			K = kind;
+			area = a;
+			cost = c;
+			nk = n;
+		}
+	}
+	double per_px = (cost - nk * r->cost_job) / (double)area;
+	if (per_px < 0.0)
+		per_px = 0.0;
+	size_t *sel = malloc(r->npre * sizeof(*sel));
+	struct plan_region *regs = malloc(r->npre * sizeof(*regs));
+	if (!sel || !regs) {
+		free(sel);
+		free(regs);
+		return 0;
+	}
+	size_t m = 0;
+	long px = 0;
+	for (size_t b = 0; b < r->npre; b++) {
+		const struct plan_region *band = &r->pre_reg[b];
+		if (!of_kind(band, K))
+			continue;
+		int touched = 0;
+		for (size_t k = 0; k < pl->nregions && !touched; k++) {
+			const struct plan_region *g = &pl->regions[k];
+			touched = of_kind(g, K) && g->y1 >= band->y0 && g->y0 <= band->y1;
+		}
+		if (!touched)
+			continue;
+		long a = (long)(band->x1 - band->x0 + 1) * (band->y1 - band->y0 + 1);
+		sel[m] = b;
+		regs[m] = *band;
+		regs[m].cost = r->cost_job + per_px * (double)a;
+		px += a;
+		m++;
+	}
+	double cover = (double)m * r->cost_job + per_px * (double)px;
+	if (!m || cover > cost + 0.5 * r->latency * r->cores) {
+		free(sel);
+		free(regs);
+		return 0;
+	}
+	free(pl->regions);
+	pl->regions = regs;
+	pl->nregions = m;
+	pl->pixels = px;
+	const int f = K.scale == ACC_AA ? ACC_GRID_FRAME : K.scale;
+	pl->samples = (double)px * f * f;
+	pl->cost = cover;
+	*idx = sel;
+	return m;
+}
+
 /* The base pass: the whole image, one sample per pixel. */
 static int base_pass(struct run *r, char *err, size_t errlen)
 {
@@ -734,6 +1005,7 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	struct pov_result res = {0};
 	double t = now_s(), c = self_cpu();
 	progress(r, "base pass: %dx%d, 1 sample per pixel", r->w, r->h);
+	prelaunch_first(r);
 	/* one sample at each pixel centre; radiosity, if the scene has any, is
 	 * saved for the region renders */
 	int ret = whole_frame(r, 1, r->cores, out, r->radfile, "base pass", &res, err, errlen);
@@ -791,6 +1063,8 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	p.est_relmse = NAN;	/* filled in by the first analysis */
 	/* at scale 1 the radiosity pass only repeats a base pass that ran on
 	 * several threads */
+	if (r->radiosity)
+		prelaunch_end(r, &p);	/* region renders load its solution */
 	int k = r->radiosity ? radiosity_scale(r) : 0;
 	if (k > 1 || (k == 1 && r->cores > 1)) {
 		int rrc = radiosity_pass(r, k, &p, err, errlen);
@@ -932,6 +1206,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	/* what a pass keeps of the budget after its renders: the time of the
 	 * last analysis and 0.1 s; its renders' deadline is the rest */
 	const double reserve = r->passes[r->npasses - 1].analysis_s + 0.1;
+	int fit = 2;	/* passes that still fit the budget, this one included */
 	if (r->budget > 0.0) {
 		double left = r->budget - elapsed(r);
 		/* in core-seconds, keeping a share for the analysis and the
@@ -945,7 +1220,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		/* the passes that still fit, each waiting on POV-Ray's latency
 		 * and the analysis: when only one or two do, this pass takes
 		 * its share of the budget even past the pixels' next scales */
-		int fit = (int)((left - 0.2) / (r->latency + reserve));
+		fit = (int)((left - 0.2) / (r->latency + reserve));
 		if (fit <= 2)
 			pp.fill = fit <= 1 ? pp.budget : pp.budget / fit;
 	}
@@ -966,7 +1241,22 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		progress(r, "pass %d: the frame at scale 4 costs less than the cores wait on "
 			 "POV-Ray's latency: no scale 2, scale 4 and up jittered", pass);
 	}
-	const size_t naa = choose_samplers(r, &pl, &sparse);
+	size_t naa = choose_samplers(r, &pl, &sparse);
+	/* renders started early for this pass: taken, or stopped */
+	struct pass_rec pre_rec = {0};
+	size_t *pre_idx = NULL;
+	struct pov_prelaunch *pre = NULL;
+	if (prelaunch_cover(r, pass, &pl, &pre_idx)) {
+		pre = r->pre;
+		r->pre = NULL;
+		naa = 0;
+		for (size_t k = 0; k < pl.nregions; k++)
+			naa += pl.regions[k].scale == ACC_AA;
+		progress(r, "pass %d: %zu region renders started %s", pass, pl.nregions,
+			 pass == 1 ? "with the base pass" : "during the pass before");
+	} else {
+		prelaunch_end(r, &pre_rec);
+	}
 	size_t n = pl.nregions;
 	struct pov_job *jobs = calloc(n, sizeof(*jobs));
 	struct pov_region *regs = calloc(n, sizeof(*regs));
@@ -988,7 +1278,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	base.ndefines = 1;
 	for (size_t k = 0; k < n; k++) {
 		char name[PATH_MAX];
-		plan_output_name(name, sizeof name, r->workdir, pass, k, pl.regions[k].scale);
+		plan_output_name(name, sizeof name, r->workdir, pass, pre_idx ? pre_idx[k] : k,
+				 pl.regions[k].scale);
 		outs[k] = strdup(name);
 		if (!outs[k]) {
 			errbuf_printf(err, errlen, "out of memory");
@@ -1016,6 +1307,11 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	po.on_done = on_done;
 	po.ready = output_whole;
 	po.arg = r;
+	po.prelaunched = pre;
+	/* the next pass's likely renders wait through their start-up while
+	 * this pass renders (not when this is the last pass that fits) */
+	if (fit > 1)
+		prelaunch_next(r, pass + 1, &pl, &pp);
 	if (r->budget > 0.0) {
 		/* the budget holds even when the cost model is wrong (a region
 		 * of glossy floor costs more per sample than the frame's
@@ -1041,9 +1337,12 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	progress(r, "pass %d: %zu regions, %ld pixels (%ld chosen), %.0f samples, about %.1f s",
 		 pass, n, pl.pixels, pl.chosen_pixels, pl.samples, guess + r->latency);
 	int rc = pov_pool_run(jobs, n, &po, results, err, errlen);
+	struct pass_rec p = {0};
+	p.prelaunched = (int)pov_prelaunch_taken(pre);
+	p.cpu_s = pre_rec.cpu_s + pov_prelaunch_end(pre);
+	pre = NULL;
 	if (rc < 0)
 		goto out;
-	struct pass_rec p = {0};
 	p.pass = pass;
 	int stopped = 0;
 	for (size_t k = 0; k < n; k++) {
@@ -1092,7 +1391,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	double lat = INFINITY;
 	for (size_t k = 0; k < n; k++)
 		if (results[k].status == POV_OK && results[k].attempts == 1 &&
-		    results[k].wall_s - results[k].cpu_s < lat)
+		    !results[k].prelaunched && results[k].wall_s - results[k].cpu_s < lat)
 			lat = results[k].wall_s - results[k].cpu_s;
 	if (lat < INFINITY)
 		r->latency = lat > 0.0 ? lat : 0.0;
@@ -1122,6 +1421,8 @@ out:
 	free(outs);
 	free(results);
 	free(bextra);
+	free(pre_idx);
+	pov_prelaunch_end(pre);
 	plan_release(&pl);
 	return ret;
 }
@@ -1168,6 +1469,7 @@ int cmd_render(int argc, char **argv)
 	r.rad_scale = 1;
 	r.user_rad_scale = -1;
 	r.grid = PLAN_GRID_LARGE;
+	r.prelaunch = PRE_AUTO;
 	char emap[PATH_MAX], wdir[PATH_MAX];
 
 	int i = 1;
@@ -1205,6 +1507,16 @@ int cmd_render(int argc, char **argv)
 				goto bad;
 		} else if (!strcmp(a, "--budget")) {
 			if (args_double(argv[++i], 1e-3, 1e9, &r.budget))
+				goto bad;
+		} else if (!strcmp(a, "--prelaunch")) {
+			const char *v = argv[++i];
+			if (!strcmp(v, "auto"))
+				r.prelaunch = PRE_AUTO;
+			else if (!strcmp(v, "on"))
+				r.prelaunch = PRE_ON;
+			else if (!strcmp(v, "off"))
+				r.prelaunch = PRE_OFF;
+			else
 				goto bad;
 		} else if (!strcmp(a, "--cost-job")) {
 			if (args_double(argv[++i], 1e-9, 1e6, &r.user_cost_job))
@@ -1437,6 +1749,8 @@ bad:
 		pass++;
 	}
 
+	prelaunch_end(&r, &r.passes[r.npasses - 1]);	/* guesses for a pass not run */
+
 	/* the final image, error map and report.  The planner and the stop
 	 * went by the samples' errors; the error map and the estimate are the
 	 * final image's: under --final auto, the blend's predicted error where it
@@ -1491,6 +1805,7 @@ fail_early:
 	fprintf(stderr, "povpress render: %s\n", err);
 	return 1;
 done:
+	prelaunch_end(&r, NULL);
 	pov_signals_restore();
 	lpr_result_release(&res);
 	image_release(&r.acc);

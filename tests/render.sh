@@ -470,10 +470,11 @@ done
 
 # --- a budget is a deadline: a pass planned far over it is stopped in time ----
 # --cost-sample 1e-9: the planner thinks samples free and plans a pass that
-# would take many times the budget
+# would take many times the budget (--prelaunch off: a pass that takes
+# renders started early leaves its dearer regions to the next)
 t0=$EPOCHREALTIME
 "$PP" render "$SC/media.pov" -o "$T/dl.exr" -W 80 -H 60 --budget 3 --target 1e-6 \
-	--cost-sample 1e-9 --workdir "$T/dl work" -v 2>"$T/dl.err"
+	--cost-sample 1e-9 --prelaunch off --workdir "$T/dl work" -v 2>"$T/dl.err"
 rc=$?
 dt=$(awk -v a="$t0" -v b="$EPOCHREALTIME" 'BEGIN { printf "%.2f", b - a }')
 check "budget deadline: a run whose pass is planned as free succeeds" test $rc -eq 0
@@ -482,6 +483,55 @@ check "... its region renders are stopped at the budget's end" \
 check "... and it ends within the 3 s budget ($dt s)" num 'a <= 3.3' "$dt"
 check "... the output is a complete image" valid_exr "$T/dl.exr"
 check "... no POV-Ray child left" no_povray_left "$T/dl work"
+
+# --- --prelaunch: renders started a pass early, taken or stopped -----------
+for m in auto off; do
+	"$PP" render "$SC/soft_shadows.pov" -o "$T/pl-$m.exr" -W $W -H $H --budget 3 \
+		--target 1e-6 --prelaunch $m --workdir "$T/pl $m" --keep-workdir \
+		--report "$T/pl-$m.json" -v 2>"$T/pl-$m.log"
+	eval "rc_$m=$?"
+done
+taken=$(grep '"pass": 1,' "$T/pl-auto.json" | grep -o '"prelaunched": [0-9]*' | awk '{ print $2 }')
+check "--prelaunch auto under a budget: the run succeeds" test "$rc_auto" -eq 0
+check "... its first pass takes renders started with the base pass ($taken)" \
+	test "${taken:-0}" -ge 1
+check "... and says so" grep -q "started with the base pass" "$T/pl-auto.log"
+check "... the report names the mode" grep -q '"prelaunch": "auto"' "$T/pl-auto.json"
+check "... no gate left in the work directory" \
+	test -z "$(find "$T/pl auto" -name 'gate-*')"
+check "... no POV-Ray child left" no_povray_left "$T/pl auto"
+check "... the output is a complete image" valid_exr "$T/pl-auto.exr"
+check "--prelaunch off: the run succeeds" test "$rc_off" -eq 0
+check "... and no pass takes an early render" \
+	test "$(grep -o '"prelaunched": [1-9]' "$T/pl-off.json" | wc -l)" -eq 0
+"$PP" render "$SC/soft_shadows.pov" -o "$T/pl-bad.exr" --prelaunch maybe 2>"$T/pl-bad.log"
+check "--prelaunch maybe is a usage error (2)" test $? -eq 2
+check "... whose message names the option" grep -q -- "--prelaunch" "$T/pl-bad.log"
+# a header of the user's own (+HI): no gate takes its place
+mkdir -p "$T/hi"
+printf '#declare User_Colour = rgb <1, 0.5, 0.2>;\n' >"$T/hi/user.inc"
+cat >"$T/hi/s.pov" <<'SCENE'
+#version 3.7;
+global_settings { assumed_gamma 1.0 }
+camera { location <0, 1, -4> look_at 0 }
+light_source { <-3, 5, -4> color rgb 1 area_light x, z, 4, 4 jitter }
+plane { y, -1 pigment { checker color rgb 1 color rgb 0.2 } }
+sphere { 0, 1 pigment { color User_Colour } }
+SCENE
+"$PP" render "$T/hi/s.pov" -o "$T/hi/out.exr" -W $W -H $H --budget 3 --target 1e-6 \
+	--report "$T/hi/r.json" -q -- "+HI$T/hi/user.inc" 2>"$T/hi/err"
+check "a scene needing the user's +HI header renders under a budget" test $? -eq 0
+check "... and no early render took the header's place" \
+	test "$(grep -o '"prelaunched": [1-9]' "$T/hi/r.json" | wc -l)" -eq 0
+# interrupted while the early renders wait at their gates
+"$PP" render "$SC/focal_blur.pov" -o "$T/pl-int.exr" -W $W -H $H --budget 5 --target 1e-6 \
+	-q --workdir "$T/pl int" &
+pid=$!
+sleep 0.2
+kill -INT $pid
+wait $pid
+check "SIGINT during the base pass: exits 130" test $? -eq 130
+check "... no POV-Ray child left, waiting or not" no_povray_left "$T/pl int"
 
 # --- SIGINT: children stopped, output absent or valid, --resume finishes ----
 mkdir -p "$T/int"

@@ -159,9 +159,10 @@ static const char *make_tiny_scene(char *path, size_t len, const char *dir, cons
 	char inc[PATH_MAX];
 
 	mkdir_p(dir);
-	snprintf(inc, sizeof(inc), "%s/tiny_colours.inc", dir);
+	if (snprintf(inc, sizeof(inc), "%s/tiny_colours.inc", dir) >= (int)sizeof(inc) ||
+	    snprintf(path, len, "%s/%s", dir, name) >= (int)len)
+		fail_msg("path too long in '%s'", dir);
 	write_file(inc, "#declare Tiny_Colour = rgb <1, 0.5, 0.2>;\n");
-	snprintf(path, len, "%s/%s", dir, name);
 	write_file(path, tiny_scene);
 	return path;
 }
@@ -1505,6 +1506,83 @@ static void test_signal_before_pool(void **state)
 	pov_result_release(&res);
 }
 
+/* Pre-launched renders: the ones a pool's jobs match are taken and begin at
+ * their gate, without POV-Ray's start-up wait, rendering what a fresh
+ * start renders; the one no job matches is stopped; no gate, process or
+ * output of theirs is left. */
+static void test_prelaunch(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], gates[PATH_MAX], other[PATH_MAX], fresh[PATH_MAX],
+	     err[512];
+	char outs[3][PATH_MAX];
+	struct pov_region regs[3] = { { 0, 0, 31, 11 }, { 0, 12, 31, 23 }, { 4, 4, 9, 9 } };
+	struct pov_job jobs[3], pool[3];
+	struct pov_result res[3], fres;
+	struct pov_pool_opts o;
+	struct pov_prelaunch *pre = NULL;
+	struct image a = { 0 }, b = { 0 };
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "prelaunch"), "s.pov");
+	mkdir_p(scratch(gates, sizeof(gates), "prelaunch/gates"));
+	memset(jobs, 0, sizeof(jobs));
+	for (int k = 0; k < 3; k++) {
+		char name[64];
+
+		snprintf(name, sizeof(name), "prelaunch/p%d.exr", k);
+		jobs[k].scene = scene;
+		jobs[k].output = scratch(outs[k], sizeof(outs[k]), name);
+		jobs[k].width = 32;
+		jobs[k].height = 24;
+		jobs[k].threads = 1;
+		jobs[k].region = &regs[k];
+	}
+	assert_int_equal(pov_prelaunch_start(jobs, 3, gates, &pre, err, sizeof(err)), 0);
+	assert_int_equal(count_procs("prelaunch/gates/gate-"), 3);
+	pause_s(1.0);	/* through POV-Ray's start-up, to the gate */
+	for (int k = 0; k < 3; k++)
+		assert_false(exists(outs[k]));	/* waiting there */
+	/* jobs 1 and 0 as they were; job 2's region into another file */
+	pool[0] = jobs[1];
+	pool[1] = jobs[0];
+	pool[2] = jobs[2];
+	pool[2].output = scratch(other, sizeof(other), "prelaunch/other.exr");
+	pov_pool_opts_init(&o);
+	o.max_jobs = 3;
+	o.prelaunched = pre;
+	assert_int_equal(pov_pool_run(pool, 3, &o, res, err, sizeof(err)), 0);
+	for (int k = 0; k < 3; k++)
+		assert_int_equal(res[k].status, POV_OK);
+	assert_int_equal(res[0].prelaunched, 1);
+	assert_int_equal(res[1].prelaunched, 1);
+	assert_int_equal(res[2].prelaunched, 0);
+	assert_int_equal(pov_prelaunch_taken(pre), 2);
+	/* from the gate to the image, against a start from nothing */
+	assert_true(res[0].wall_s < res[2].wall_s && res[1].wall_s < res[2].wall_s);
+	assert_true(pov_prelaunch_end(pre) >= 0.0);
+	assert_int_equal(count_procs("prelaunch/gates/gate-"), 0);
+	assert_false(exists(outs[2]));
+	DIR *d = opendir(gates);
+	assert_non_null(d);
+	int left = 0;
+	for (struct dirent *e; (e = readdir(d));)
+		left += e->d_name[0] != '.';
+	closedir(d);
+	assert_int_equal(left, 0);
+	/* a taken render's image is a fresh render's */
+	pool[0].output = scratch(fresh, sizeof(fresh), "prelaunch/fresh.exr");
+	assert_int_equal(run_pool(pool, 1, 1, 20, 0, &fres), 0);
+	assert_int_equal(fres.status, POV_OK);
+	assert_int_equal(image_read_exr(outs[1], &a, err, sizeof(err)), 0);
+	assert_int_equal(image_read_exr(fresh, &b, err, sizeof(err)), 0);
+	assert_int_equal(a.w * a.h * a.nch, b.w * b.h * b.nch);
+	assert_memory_equal(a.px, b.px, (size_t)a.w * a.h * a.nch * sizeof(*a.px));
+	image_release(&a);
+	image_release(&b);
+	pov_result_release(&fres);
+	release_all(res, 3);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -1530,6 +1608,7 @@ int main(void)
 		cmocka_unit_test(test_pool_error_messages),
 		cmocka_unit_test(test_render_awkward_paths),
 		cmocka_unit_test(test_render_region),
+		cmocka_unit_test(test_prelaunch),
 		cmocka_unit_test(test_render_parse_error),
 		cmocka_unit_test(test_timeout_kills),
 		cmocka_unit_test(test_pool_deadline),
