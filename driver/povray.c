@@ -1968,10 +1968,12 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 		errbuf_printf(err, errlen, "out of memory");
 		goto out;
 	}
-	/* Everything that can be checked is checked before anything starts. */
 	for (size_t i = 0; i < njobs; i++) {
 		p.pj[i].fd = -1;
 		p.pj[i].gate = -1;
+	}
+	/* Everything that can be checked is checked before anything starts. */
+	for (size_t i = 0; i < njobs; i++) {
 		if (pov_find_binary(&jobs[i], bin, sizeof(bin), err, errlen) ||
 		    cmd_build(&jobs[i], &p.pj[i].cmd, err, errlen))
 			goto out;
