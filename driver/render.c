@@ -147,8 +147,11 @@ static double self_cpu(void)
 	       ru.ru_stime.tv_usec * 1e-6;
 }
 
-/* --prelaunch */
+/* --prelaunch, its values in the order of their names */
 enum { PRE_OFF, PRE_AUTO, PRE_ON };
+static const char *const prelaunch_names[] = { "off", "auto", "on" };
+/* --final's, in enum accum_final's order */
+static const char *const final_names[] = { "auto", "samples", "reconstruction" };
 #define PRE_KINDS 3	/* scale 2, scale 4 as a grid render, antialiased */
 #define PRE_BANDS 8
 #define PRE_MAX (PRE_KINDS * PRE_BANDS)
@@ -573,7 +576,7 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 		r->cost_job, r->cost_sample, r->latency, cost_scale(r), r->radiosity ? "true" : "false",
 		r->rad_scale, r->aa ? "aa" : plan_grid_name(r->grid),
 		r->aa ? "aa" : plan_grid_name(run_grid(r)),
-		r->prelaunch == PRE_ON ? "on" : r->prelaunch == PRE_OFF ? "off" : "auto");
+		prelaunch_names[r->prelaunch]);
 	for (size_t k = 0; k < r->npasses; k++) {
 		const struct pass_rec *p = &r->passes[k];
 		fprintf(f, "    {\"pass\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, "
@@ -1544,6 +1547,15 @@ static int check_writable(const char *what, const char *path, char *err, size_t 
 	return 0;
 }
 
+/* The index of v among the n names, or -1. */
+static int name_index(const char *v, const char *const *names, int n)
+{
+	for (int k = 0; k < n; k++)
+		if (!strcmp(v, names[k]))
+			return k;
+	return -1;
+}
+
 int cmd_render(int argc, char **argv)
 {
 	struct run r;
@@ -1598,14 +1610,7 @@ int cmd_render(int argc, char **argv)
 			if (args_double(argv[++i], 1e-3, 1e9, &r.budget))
 				goto bad;
 		} else if (!strcmp(a, "--prelaunch")) {
-			const char *v = argv[++i];
-			if (!strcmp(v, "auto"))
-				r.prelaunch = PRE_AUTO;
-			else if (!strcmp(v, "on"))
-				r.prelaunch = PRE_ON;
-			else if (!strcmp(v, "off"))
-				r.prelaunch = PRE_OFF;
-			else
+			if ((r.prelaunch = name_index(argv[++i], prelaunch_names, 3)) < 0)
 				goto bad;
 		} else if (!strcmp(a, "--cost-job")) {
 			if (args_double(argv[++i], 1e-9, 1e6, &r.user_cost_job))
@@ -1640,15 +1645,10 @@ int cmd_render(int argc, char **argv)
 			if (r.grid < 0)
 				goto bad;
 		} else if (!strcmp(a, "--final")) {
-			const char *m = argv[++i];
-			if (!strcmp(m, "auto"))
-				r.final = ACC_FINAL_AUTO;
-			else if (!strcmp(m, "samples"))
-				r.final = ACC_FINAL_SAMPLES;
-			else if (!strcmp(m, "reconstruction"))
-				r.final = ACC_FINAL_RECONSTRUCTION;
-			else
+			int f = name_index(argv[++i], final_names, 3);
+			if (f < 0)
 				goto bad;
+			r.final = (enum accum_final)f;
 		} else if (a[0] == '-' && a[1]) {
 			fprintf(stderr, "povpress render: unknown option '%s'\n", a);
 			print_usage(stderr);
