@@ -824,6 +824,38 @@ static int of_kind(const struct plan_region *g, struct pre_kind k)
 	return g->scale == k.scale && (g->frame > 0) == (k.frame > 0);
 }
 
+/* The kind of plan pl's regions with the most pixels, their pixels in
+ * *area (0 when pl has none), their predicted cost in *cost and their
+ * count in *n. */
+static struct pre_kind main_kind(const struct plan *pl, long *area, double *cost, int *n)
+{
+	struct pre_kind best = { 0, 0 };
+	*area = 0;
+	*cost = 0.0;
+	*n = 0;
+	for (size_t k = 0; k < pl->nregions; k++) {
+		struct pre_kind kind = { pl->regions[k].scale, pl->regions[k].frame };
+		long a = 0;
+		double c = 0.0;
+		int m = 0;
+		for (size_t j = 0; j < pl->nregions; j++) {
+			const struct plan_region *g = &pl->regions[j];
+			if (!of_kind(g, kind))
+				continue;
+			a += (long)(g->x1 - g->x0 + 1) * (g->y1 - g->y0 + 1);
+			c += g->cost;
+			m++;
+		}
+		if (a > *area) {
+			best = kind;
+			*area = a;
+			*cost = c;
+			*n = m;
+		}
+	}
+	return best;
+}
+
 /* Start nb bands of each of the nk kinds for pass `pass` (r->pre). */
 static void prelaunch_start(struct run *r, int pass, const struct pre_kind *kinds, int nk, int nb)
 {
@@ -929,21 +961,10 @@ static void prelaunch_first(struct run *r)
 static void prelaunch_next(struct run *r, int pass, const struct plan *pl,
 			   const struct plan_params *pp)
 {
-	struct pre_kind best = { 0, 0 };
-	long best_area = 0;
-	for (size_t k = 0; k < pl->nregions; k++) {
-		const struct plan_region *g = &pl->regions[k];
-		struct pre_kind kind = { g->scale, g->frame };
-		long area = 0;
-		for (size_t j = 0; j < pl->nregions; j++)
-			if (of_kind(&pl->regions[j], kind))
-				area += (long)(pl->regions[j].x1 - pl->regions[j].x0 + 1) *
-					(pl->regions[j].y1 - pl->regions[j].y0 + 1);
-		if (area > best_area) {
-			best_area = area;
-			best = kind;
-		}
-	}
+	long best_area;
+	double best_cost;
+	int nbest;
+	struct pre_kind best = main_kind(pl, &best_area, &best_cost, &nbest);
 	int s = best.scale == ACC_AA ? 4 : 2 * best.scale;
 	if (!best_area || s > accum_scales[ACC_NSCALES - 1])
 		return;
@@ -980,30 +1001,10 @@ static size_t prelaunch_cover(struct run *r, int pass, struct plan *pl, size_t *
 	*idx = NULL;
 	if (!r->pre || r->pre_pass != pass || !pl->nregions)
 		return 0;
-	struct pre_kind K = { 0, 0 };
-	long area = 0;
-	double cost = 0.0;
-	int nk = 0;
-	for (size_t k = 0; k < pl->nregions; k++) {
-		struct pre_kind kind = { pl->regions[k].scale, pl->regions[k].frame };
-		long a = 0;
-		double c = 0.0;
-		int n = 0;
-		for (size_t j = 0; j < pl->nregions; j++) {
-			const struct plan_region *g = &pl->regions[j];
-			if (!of_kind(g, kind))
-				continue;
-			a += (long)(g->x1 - g->x0 + 1) * (g->y1 - g->y0 + 1);
-			c += g->cost;
-			n++;
-		}
-		if (a > area) {
-			K = kind;
-			area = a;
-			cost = c;
-			nk = n;
-		}
-	}
+	long area;
+	double cost;
+	int nk;
+	const struct pre_kind K = main_kind(pl, &area, &cost, &nk);
 	const double job = r->cost_job * cost_scale(r);	/* as the plan costs it */
 	double per_px = (cost - nk * job) / (double)area;
 	if (per_px < 0.0)
