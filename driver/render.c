@@ -389,6 +389,19 @@ static void base_job(const struct run *r, struct pov_job *job, const char **extr
 		extra[k] = r->extra[k];
 }
 
+/* A region render's job of pass `pass` (base_job() on one thread, and
+ * POVPRESS_PASS declared); passno and pd hold what it points to. */
+static void pass_job(const struct run *r, int pass, struct pov_job *job, const char **extra,
+		     char passno[16], struct pov_define *pd)
+{
+	base_job(r, job, extra, 1);
+	snprintf(passno, 16, "%d", pass);
+	pd->name = "POVPRESS_PASS";
+	pd->value = passno;
+	job->defines = pd;
+	job->ndefines = 1;
+}
+
 static void on_done(void *arg, size_t index, const struct pov_result *res)
 {
 	struct run *r = arg;
@@ -885,12 +898,9 @@ static void prelaunch_start(struct run *r, int pass, const struct pre_kind *kind
 		return;
 	const char **bextra = extras + (size_t)PRE_MAX * (r->nextra + 4);
 	struct pov_job base;
-	base_job(r, &base, bextra, 1);
 	char passno[16];
-	snprintf(passno, sizeof passno, "%d", pass);
-	const struct pov_define pd = { "POVPRESS_PASS", passno };
-	base.defines = &pd;
-	base.ndefines = 1;
+	struct pov_define pd;
+	pass_job(r, pass, &base, bextra, passno, &pd);
 	size_t n = 0;
 	for (int t = 0; t < nk; t++) {
 		for (int b = 0; b < nb; b++) {
@@ -1342,12 +1352,9 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		goto out;
 	}
 	struct pov_job base;
-	base_job(r, &base, bextra, 1);
 	char passno[16];
-	snprintf(passno, sizeof passno, "%d", pass);
-	const struct pov_define pd = { "POVPRESS_PASS", passno };
-	base.defines = &pd;
-	base.ndefines = 1;
+	struct pov_define pd;
+	pass_job(r, pass, &base, bextra, passno, &pd);
 	for (size_t k = 0; k < n; k++) {
 		char name[PATH_MAX];
 		plan_output_name(name, sizeof name, r->workdir, pass, pre_idx ? pre_idx[k] : k,
