@@ -129,8 +129,7 @@ static int by_score(const void *a, const void *b)
 
 static double rect_cost(const struct plan_params *p, const struct plan_region *r)
 {
-	double area = (double)(r->x1 - r->x0 + 1) * (r->y1 - r->y0 + 1);
-	return p->cost_job + p->cost_sample * area * r->scale * r->scale;
+	return p->cost_job + p->cost_sample * (double)plan_region_area(r) * r->scale * r->scale;
 }
 
 static void bbox(const struct plan_region *a, const struct plan_region *b,

@@ -91,6 +91,12 @@ struct plan_region {
 				 * render.c, choose_samplers()) */
 };
 
+/* Pixels in r. */
+static inline long plan_region_area(const struct plan_region *r)
+{
+	return (long)(r->x1 - r->x0 + 1) * (r->y1 - r->y0 + 1);
+}
+
 enum plan_outcome {
 	PLAN_REFINE,		/* regions to render */
 	PLAN_TARGET_MET,	/* the estimate is at or below the target */

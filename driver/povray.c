@@ -1387,6 +1387,13 @@ static const char *signame(int sig)
 	return s ? s : "unknown signal";
 }
 
+/* User + system seconds of a reaped child. */
+static double rusage_cpu_s(const struct rusage *ru)
+{
+	return (double)ru->ru_utime.tv_sec + 1e-6 * (double)ru->ru_utime.tv_usec +
+	       (double)ru->ru_stime.tv_sec + 1e-6 * (double)ru->ru_stime.tv_usec;
+}
+
 /* The child j has exited (not yet reaped): reap it and judge the attempt.
  * Returns 1 when the job should run again. */
 static int finish(struct pjob *j, const struct pov_pool_opts *opts, double t0,
@@ -1417,8 +1424,7 @@ static int finish(struct pjob *j, const struct pov_pool_opts *opts, double t0,
 	j->pid = 0;
 	res->wall_s += end - j->start;
 	res->end_s = end - t0;
-	res->cpu_s += (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
-		      (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+	res->cpu_s += rusage_cpu_s(&ru);
 	res->exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 	res->term_signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
 	if (j->early && res->term_signal == SIGKILL) {
@@ -1763,8 +1769,7 @@ static void prelaunch_stop(struct pov_prelaunch *pre, size_t k)
 	memset(&ru, 0, sizeof(ru));
 	while (wait4(j->pid, &status, 0, &ru) < 0 && errno == EINTR)
 		;
-	pre->cpu_s += (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
-		      (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
+	pre->cpu_s += rusage_cpu_s(&ru);
 	j->pid = 0;
 	unlink(j->cmd.povout);
 	unlink(j->cmd.state);
@@ -1800,21 +1805,18 @@ size_t pov_prelaunch_taken(const struct pov_prelaunch *pre)
 int pov_prelaunch_start(const struct pov_job *jobs, size_t njobs, const char *gatedir,
 			struct pov_prelaunch **out, char *err, size_t errlen)
 {
-	char bin[PATH_MAX];
-	struct pov_result res;
-	int devnull = -1;
-
 	*out = NULL;
 #ifndef __linux__
 	(void)jobs;
 	(void)njobs;
 	(void)gatedir;
-	(void)bin;
-	(void)res;
-	(void)devnull;
 	errbuf_printf(err, errlen, "pre-launched renders need Linux");
 	return -1;
 #else
+	char bin[PATH_MAX];
+	struct pov_result res;
+	int devnull = -1;
+
 	if (!pov_path_safe(gatedir)) {
 		errbuf_printf(err, errlen, "cannot pre-launch renders: unsafe directory '%s'",
 			      gatedir);

@@ -21,7 +21,6 @@
 #include "driver/povray.h"
 #include "regression/lpr.h"
 
-#include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
 #include <limits.h>
@@ -31,6 +30,7 @@
 #include <stdlib.h>
 #include <stdint.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <time.h>
@@ -808,23 +808,15 @@ out:
  * where the error sits in few pixels), in min(cores, jobs) bands; a later
  * pass's: the next scale of the pass before's main kind, in twice as many.
  */
-static int ci_at(const char *a, const char *lower)
-{
-	for (; *lower; a++, lower++)
-		if (tolower((unsigned char)*a) != *lower)
-			return 0;
-	return 1;
-}
-
 static int is_user_header(const char *a)
 {
 	size_t n = strlen(a);
-	if ((a[0] == '+' || a[0] == '-') && ci_at(a + 1, "hi"))
+	if ((a[0] == '+' || a[0] == '-') && !strncasecmp(a + 1, "hi", 2))
 		return 1;
 	for (size_t i = 0; i + 14 <= n; i++)
-		if (ci_at(a + i, "include_header"))
+		if (!strncasecmp(a + i, "include_header", 14))
 			return 1;
-	return n > 4 && ci_at(a + n - 4, ".ini");
+	return n > 4 && !strcasecmp(a + n - 4, ".ini");
 }
 
 struct pre_kind {
@@ -855,7 +847,7 @@ static struct pre_kind main_kind(const struct plan *pl, long *area, double *cost
 			const struct plan_region *g = &pl->regions[j];
 			if (!of_kind(g, kind))
 				continue;
-			a += (long)(g->x1 - g->x0 + 1) * (g->y1 - g->y0 + 1);
+			a += plan_region_area(g);
 			c += g->cost;
 			m++;
 		}
@@ -930,20 +922,9 @@ static void prelaunch_start(struct run *r, int pass, const struct pre_kind *kind
 /* Whether the scene file's text holds word (not the files it includes). */
 static int scene_mentions(const char *path, const char *word)
 {
-	FILE *f = fopen(path, "rb");
-	if (!f)
-		return 0;
-	char buf[65536];
-	size_t keep = 0, n, wl = strlen(word);
-	int found = 0;
-	while (!found && (n = fread(buf + keep, 1, sizeof buf - 1 - keep, f)) > 0) {
-		n += keep;
-		buf[n] = '\0';
-		found = strstr(buf, word) != NULL;	/* text: a NUL ends the search */
-		keep = n >= wl ? wl - 1 : n;	/* a word across the chunks */
-		memmove(buf, buf + n - keep, keep);
-	}
-	fclose(f);
+	char *text = file_read_text(path);
+	int found = text && strstr(text, word);	/* text: a NUL ends the search */
+	free(text);
 	return found;
 }
 
@@ -986,16 +967,13 @@ static void prelaunch_next(struct run *r, int pass, const struct plan *pl,
 	prelaunch_start(r, pass, &kind, 1, 2 * r->cores);
 }
 
-/* Stop the early renders none took; their CPU goes to pass record p. */
-static void prelaunch_end(struct run *r, struct pass_rec *p)
+/* Stop the early renders none took; returns the CPU seconds they used. */
+static double prelaunch_end(struct run *r)
 {
-	if (!r->pre)
-		return;
 	double cpu = pov_prelaunch_end(r->pre);
-	if (p)
-		p->cpu_s += cpu;
 	r->pre = NULL;
 	r->npre = 0;
+	return cpu;
 }
 
 /*
@@ -1039,7 +1017,7 @@ static size_t prelaunch_cover(struct run *r, int pass, struct plan *pl, size_t *
 		}
 		if (!touched)
 			continue;
-		long a = (long)(band->x1 - band->x0 + 1) * (band->y1 - band->y0 + 1);
+		long a = plan_region_area(band);
 		sel[m] = b;
 		regs[m] = *band;
 		regs[m].cost = job + per_px * (double)a;
@@ -1130,7 +1108,7 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	/* at scale 1 the radiosity pass only repeats a base pass that ran on
 	 * several threads */
 	if (r->radiosity)
-		prelaunch_end(r, &p);	/* region renders load its solution */
+		p.cpu_s += prelaunch_end(r);	/* region renders load its solution */
 	int k = r->radiosity ? radiosity_scale(r) : 0;
 	if (k > 1 || (k == 1 && r->cores > 1)) {
 		int rrc = radiosity_pass(r, k, &p, err, errlen);
@@ -1216,7 +1194,7 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
 	size_t m = 0;
 	for (size_t k = 0; k < pl->nregions; k++) {
 		struct plan_region g = pl->regions[k];
-		long area = (long)(g.x1 - g.x0 + 1) * (g.y1 - g.y0 + 1);
+		long area = plan_region_area(&g);
 		if (first ? g.scale == 2 : g.scale >= 8 && 2 * lacking_aa(r, &g) >= area)
 			continue;
 		memmove(pl->regions + m + 1, pl->regions + m, (k - m) * sizeof(g));
@@ -1270,8 +1248,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	const int choose = !r->jittered && one_step(r, &sparse);
 	int fit = 2;	/* passes that still fit the budget, this one included */
 	size_t naa;
-	/* renders started early for this pass: taken, or stopped */
-	struct pass_rec pre_rec = {0};
+	/* renders started early for this pass: taken, or stopped (their CPU) */
+	double pre_cpu = 0.0;
 	size_t *pre_idx = NULL;
 	struct pov_prelaunch *pre = NULL;
 	int early = r->pre && r->pre_pass == pass;
@@ -1320,7 +1298,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		/* the early renders do not serve this plan: plan again for
 		 * renders that wait on POV-Ray's start-up */
 		plan_release(&pl);
-		prelaunch_end(r, &pre_rec);
+		pre_cpu += prelaunch_end(r);
 		early = 0;
 	}
 	if (choose) {	/* made once a pass runs on it */
@@ -1337,7 +1315,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		progress(r, "pass %d: %zu region renders started %s", pass, pl.nregions,
 			 pass == 1 ? "with the base pass" : "during the pass before");
 	} else {
-		prelaunch_end(r, &pre_rec);	/* for another pass, or none */
+		pre_cpu += prelaunch_end(r);	/* for another pass, or none */
 	}
 	size_t n = pl.nregions;
 	struct pov_job *jobs = calloc(n, sizeof(*jobs));
@@ -1418,7 +1396,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	int rc = pov_pool_run(jobs, n, &po, results, err, errlen);
 	struct pass_rec p = {0};
 	p.prelaunched = (int)pov_prelaunch_taken(pre);
-	p.cpu_s = pre_rec.cpu_s + pov_prelaunch_end(pre);
+	p.cpu_s = pre_cpu + pov_prelaunch_end(pre);
 	pre = NULL;
 	if (rc < 0)
 		goto out;
@@ -1478,21 +1456,18 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	/* what a region render waits on besides its CPU, for the budget's
 	 * next passes: less than the base pass's latency, since the pool does
 	 * not wait for POV-Ray to exit (output_whole()) */
-	double lat = INFINITY;
-	for (size_t k = 0; k < n; k++)
-		if (results[k].status == POV_OK && results[k].attempts == 1 &&
-		    !results[k].prelaunched && results[k].wall_s - results[k].cpu_s < lat)
-			lat = results[k].wall_s - results[k].cpu_s;
-	if (lat < INFINITY)
-		r->latency = lat > 0.0 ? lat : 0.0;
-	/* and a render started early, from its gate */
-	lat = INFINITY;
-	for (size_t k = 0; k < n; k++)
-		if (results[k].status == POV_OK && results[k].prelaunched &&
-		    results[k].wall_s - results[k].cpu_s < lat)
-			lat = results[k].wall_s - results[k].cpu_s;
-	if (lat < INFINITY)
-		r->pre_latency = lat > 0.0 ? lat : 0.0;
+	double lat[2] = { INFINITY, INFINITY };	/* from a fresh start; from a
+							 * gate (taken renders) */
+	for (size_t k = 0; k < n; k++) {
+		const int taken = results[k].prelaunched != 0;
+		if (results[k].status == POV_OK && (taken || results[k].attempts == 1) &&
+		    results[k].wall_s - results[k].cpu_s < lat[taken])
+			lat[taken] = results[k].wall_s - results[k].cpu_s;
+	}
+	if (lat[0] < INFINITY)
+		r->latency = lat[0] > 0.0 ? lat[0] : 0.0;
+	if (lat[1] < INFINITY)
+		r->pre_latency = lat[1] > 0.0 ? lat[1] : 0.0;
 	p.wall_s = now_s() - t;
 	p.driver_cpu_s = self_cpu() - c;
 	p.est_relmse = NAN;
@@ -1846,7 +1821,7 @@ bad:
 		pass++;
 	}
 
-	prelaunch_end(&r, &r.passes[r.npasses - 1]);	/* guesses for a pass not run */
+	r.passes[r.npasses - 1].cpu_s += prelaunch_end(&r);	/* guesses for a pass not run */
 
 	/* the final image, error map and report.  The planner and the stop
 	 * went by the samples' errors; the error map and the estimate are the
@@ -1902,7 +1877,7 @@ fail_early:
 	fprintf(stderr, "povpress render: %s\n", err);
 	return 1;
 done:
-	prelaunch_end(&r, NULL);
+	prelaunch_end(&r);
 	pov_signals_restore();
 	lpr_result_release(&res);
 	image_release(&r.acc);

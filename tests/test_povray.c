@@ -1558,6 +1558,8 @@ static void test_prelaunch(void **state)
 	assert_int_equal(res[2].prelaunched, 0);
 	assert_int_equal(pov_prelaunch_taken(pre), 2);
 	/* from the gate to the image, against a start from nothing */
+	print_message("prelaunch: gate to image %.3f and %.3f s, a fresh start %.3f s\n",
+		      res[0].wall_s, res[1].wall_s, res[2].wall_s);
 	assert_true(res[0].wall_s < res[2].wall_s && res[1].wall_s < res[2].wall_s);
 	assert_true(pov_prelaunch_end(pre) >= 0.0);
 	assert_int_equal(count_procs("prelaunch/gates/gate-"), 0);
