@@ -751,3 +751,18 @@ void accum_final_image(const struct image *acc, const float *fit, const float *t
 			rgb[3 * i + c] = (float)(w >= 1.0 ? f : w > 0.0 ? w * f + (1.0 - w) * m : m);
 		}
 }
+
+void accum_noise_var(const struct image *acc, size_t i, double noise, double v[3])
+{
+	const float *o = acc->px + i * ACC_NCH;
+	const double n = o[ACC_SAMPLES];
+	for (int c = 0; c < 3; c++) {
+		double vs = n >= 2.0 ? (double)o[ACC_VAR_R + c] / n : 0.0;
+		if (n >= 4.0 && isfinite(noise)) {
+			double vn = noise * ((double)o[c] * o[c] + METRICS_RELMSE_EPS);
+			if (vn < vs)
+				vs = vn;
+		}
+		v[c] = isfinite(vs) && vs > 0.0 ? vs : 0.0;
+	}
+}

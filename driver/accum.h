@@ -273,4 +273,13 @@ long accum_final_choose(const struct image *acc, const float *fit, const float *
 void accum_final_image(const struct image *acc, const float *fit, const float *take,
 		       float *rgb);
 
+/*
+ * The variance of the error of pixel i's mean, per channel, into v: its
+ * samples' variance over n (from 2 samples on; 0 before), or with 4 samples
+ * and a finite noise (accum_pixel_noise(), relative) the smaller of that and
+ * noise x (value^2 + 0.01): the fold differences see how fast the mean
+ * converges where the spread of stratified samples overstates it.
+ */
+void accum_noise_var(const struct image *acc, size_t i, double noise, double v[3]);
+
 #endif

@@ -14,9 +14,11 @@
 #include "driver/accum.h"
 #include "driver/args.h"
 #include "driver/commands.h"
+#include "driver/denoise.h"
 #include "driver/errbuf.h"
 #include "driver/files.h"
 #include "driver/image.h"
+#include "driver/metrics.h"
 #include "driver/plan.h"
 #include "driver/povray.h"
 #include "regression/lpr.h"
@@ -42,7 +44,8 @@ static const char usage[] =
 	"                       [--prelaunch auto|on|off]\n"
 	"                       [--workdir DIR] [--keep-workdir] [--resume]\n"
 	"                       [--error-map FILE] [--report FILE.json]\n"
-	"                       [--final auto|samples|reconstruction] [--radiosity-scale K]\n"
+	"                       [--final auto|blend|samples|reconstruction]\n"
+	"                       [--radiosity-scale K]\n"
 	"                       [--sampler auto|grid|scale|aa|jitter]\n"
 	"                       [-q|-v]\n"
 	"                       [-- POVRAY_OPTIONS...]\n"
@@ -116,6 +119,8 @@ static const char usage_options2[] =
 	"                        every sample added to the base pass is jittered); see\n"
 	"                        the README\n"
 	"  --final MODE          what OUT.exr holds per pixel: auto (default: the\n"
+	"                        blend below, filtered by non-local means weighted\n"
+	"                        by each pixel's measured noise), blend (the\n"
 	"                        samples' mean, blended with the regression's fit\n"
 	"                        by the two's predicted errors where the pixel's\n"
 	"                        noise is measured, like its neighbours', and the\n"
@@ -151,7 +156,7 @@ static double self_cpu(void)
 enum { PRE_OFF, PRE_AUTO, PRE_ON };
 static const char *const prelaunch_names[] = { "off", "auto", "on" };
 /* --final's, in enum accum_final's order */
-static const char *const final_names[] = { "auto", "samples", "reconstruction" };
+static const char *const final_names[] = { "auto", "samples", "reconstruction", "blend" };
 #define PRE_KINDS 3	/* scale 2, scale 4 as a grid render, antialiased */
 #define PRE_BANDS 8
 #define PRE_MAX (PRE_KINDS * PRE_BANDS)
@@ -189,6 +194,7 @@ struct run {
 	int aa;			/* --sampler aa (grid PLAN_GRID_NEVER) */
 	int prelaunch;		/* --prelaunch: PRE_AUTO, PRE_ON, PRE_OFF */
 	enum accum_final final;
+	int filter;		/* --final auto: the blend, filtered (denoise.h) */
 	const char *const *extra;
 	size_t nextra;
 	/* state */
@@ -487,13 +493,75 @@ static int analyse(struct run *r, struct lpr_result *res, char *err, size_t errl
 	return rc;
 }
 
-static int write_output(struct run *r, const struct lpr_result *res, char *err, size_t errlen)
+/*
+ * The final image into out->px: the samples' means blended with the fit
+ * (accum_final_image()), and with filter (under --final auto) the blend
+ * filtered by non-local means weighted by each pixel's noise (denoise.h).
+ * With est (the blend's per-pixel relative errors, r->est) each filtered
+ * pixel's estimate becomes the filter's: the blend's estimate less its
+ * noise part u (at most all of it), plus the larger of the filtered noise
+ * (sum w_q^2 V_q / (sum w_q)^2) and Stein's unbiased estimate of the
+ * filtered value's squared error, (F - B)^2 - V + 2 V w_p / sum w_q (B the
+ * blend, V its noise, per channel relative to B^2 + 0.01, mean over R, G,
+ * B), which also charges what the filter moved the value beyond the noise.
+ */
+static int final_image(struct run *r, const struct lpr_result *res, int filter, double *est,
+		       struct image *out, char *err, size_t errlen)
 {
 	static const char *const rgb_names[3] = { "R", "G", "B" };
-	struct image out = {0};
-	if (image_init(&out, r->w, r->h, 3, rgb_names, err, errlen))
+	const size_t npx = (size_t)r->w * r->h;
+	if (image_init(out, r->w, r->h, 3, rgb_names, err, errlen))
 		return -1;
-	accum_final_image(&r->acc, res->fit, r->take, out.px);
+	accum_final_image(&r->acc, res->fit, r->take, out->px);
+	if (!filter)
+		return 0;
+	float *var = malloc(npx * 3 * sizeof(float)), *f = malloc(npx * 3 * sizeof(float));
+	float *vf = malloc(npx * 3 * sizeof(float)), *self = malloc(npx * sizeof(float));
+	int rc = -1;
+	if (!var || !f || !vf || !self) {
+		errbuf_printf(err, errlen, "out of memory filtering the final image");
+		goto out;
+	}
+	for (size_t i = 0; i < npx; i++) {
+		double v[3];
+		accum_noise_var(&r->acc, i, r->noise[i], v);
+		for (int c = 0; c < 3; c++)
+			var[3 * i + c] = (float)v[c];
+	}
+	struct denoise_params dp;
+	denoise_params_init(&dp);
+	if (denoise_nlm(r->w, r->h, out->px, var, &dp, f, vf, self, err, errlen))
+		goto out;
+	for (size_t i = 0; est && i < npx; i++) {
+		double u = 0.0, vn = 0.0, sure = 0.0;
+		for (int c = 0; c < 3; c++) {
+			double b = out->px[3 * i + c], s = b * b + METRICS_RELMSE_EPS;
+			double d = (double)f[3 * i + c] - b, v = var[3 * i + c];
+			u += v / s / 3.0;
+			vn += vf[3 * i + c] / s / 3.0;
+			sure += (d * d - v + 2.0 * v * self[i]) / s / 3.0;
+		}
+		double e = est[i] - (u < est[i] ? u : est[i]);
+		est[i] = e + (sure > vn ? sure : vn);
+	}
+	memcpy(out->px, f, npx * 3 * sizeof(float));
+	rc = 0;
+out:
+	free(var);
+	free(f);
+	free(vf);
+	free(self);
+	if (rc)
+		image_release(out);
+	return rc;
+}
+
+static int write_output(struct run *r, const struct lpr_result *res, int filter, double *est,
+			char *err, size_t errlen)
+{
+	struct image out = {0};
+	if (final_image(r, res, filter, est, &out, err, errlen))
+		return -1;
 	int rc = image_write_exr(r->out, &out, err, errlen);
 	image_release(&out);
 	return rc;
@@ -585,11 +653,12 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 		"\"latency_s\": %.6g, \"scale\": %.4g},\n  \"radiosity\": %s,\n"
 		"  \"radiosity_scale\": %d,\n"
 		"  \"sampler\": \"%s\",\n  \"sampler_chosen\": \"%s\",\n  \"prelaunch\": \"%s\",\n"
-		"  \"passes\": [\n",
+		"  \"final\": \"%s\",\n  \"passes\": [\n",
 		r->cost_job, r->cost_sample, r->latency, cost_scale(r), r->radiosity ? "true" : "false",
 		r->rad_scale, r->aa ? "aa" : plan_grid_name(r->grid),
 		r->aa ? "aa" : plan_grid_name(run_grid(r)),
-		prelaunch_names[r->prelaunch]);
+		prelaunch_names[r->prelaunch],
+		r->final == ACC_FINAL_AUTO && !r->filter ? "blend" : final_names[r->final]);
 	for (size_t k = 0; k < r->npasses; k++) {
 		const struct pass_rec *p = &r->passes[k];
 		fprintf(f, "    {\"pass\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, "
@@ -1548,6 +1617,7 @@ int cmd_render(int argc, char **argv)
 	r.target = 1e-3;
 	r.max_passes = 8;
 	r.final = ACC_FINAL_AUTO;
+	r.filter = 1;
 	r.rad_scale = 1;
 	r.user_rad_scale = -1;
 	r.grid = PLAN_GRID_LARGE;
@@ -1628,10 +1698,12 @@ int cmd_render(int argc, char **argv)
 			if (r.grid < 0)
 				goto bad;
 		} else if (!strcmp(a, "--final")) {
-			int f = name_index(argv[++i], final_names, 3);
+			int f = name_index(argv[++i], final_names, 4);
 			if (f < 0)
 				goto bad;
-			r.final = (enum accum_final)f;
+			/* blend: auto's blend, not filtered */
+			r.final = f == 3 ? ACC_FINAL_AUTO : (enum accum_final)f;
+			r.filter = f == 0;
 		} else if (a[0] == '-' && a[1]) {
 			fprintf(stderr, "povpress render: unknown option '%s'\n", a);
 			print_usage(stderr);
@@ -1787,7 +1859,7 @@ bad:
 		last->analysis_s = now_s() - ta;
 		last->wall_s += last->analysis_s;
 		if (save_progress(&r, err, sizeof err) ||
-		    write_output(&r, &res, err, sizeof err))
+		    write_output(&r, &res, 0, NULL, err, sizeof err))
 			goto fail;
 		double el = elapsed(&r);
 		if (r.budget > 0.0)
@@ -1811,7 +1883,7 @@ bad:
 			double e_int;
 			if (analyse(&r, &res, err, sizeof err) == 0 &&
 			    estimate(&r, &res, &e_int, err, sizeof err) == 0)
-				write_output(&r, &res, err, sizeof err);
+				write_output(&r, &res, r.filter, NULL, err, sizeof err);
 			goto interrupted;
 		}
 		if (rc < 0)
@@ -1830,12 +1902,13 @@ bad:
 	 * samples') */
 	r.took = accum_final_choose(&r.acc, res.fit, res.error, res.leverage, r.noise, r.final,
 				    r.take, r.est);
+	if (write_output(&r, &res, r.filter, r.est, err, sizeof err))
+		goto fail;
 	double est = 0.0;
 	for (size_t k = 0; k < (size_t)r.w * r.h; k++)
 		est += r.est[k];
 	est /= (double)r.w * r.h;
-	if (write_output(&r, &res, err, sizeof err) ||
-	    write_error_map(&r, &res, err, sizeof err))
+	if (write_error_map(&r, &res, err, sizeof err))
 		goto fail;
 	if (r.report && write_report(&r, est, err, sizeof err))
 		goto fail;

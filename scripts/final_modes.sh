@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # What the final image should hold per pixel: `povpress render --final
-# samples|auto|reconstruction` on seven bundled scenes at 160x120, target
-# 1e-3, --jobs 4 with one POV-Ray thread (so the three runs of a scene render
+# samples|blend|auto|reconstruction` on seven bundled scenes at 160x120, target
+# 1e-3, --jobs 4 with one POV-Ray thread (so the four runs of a scene render
 # the same samples), relMSE against `make sweep`'s scale-25 references.
 #
 # usage: scripts/final_modes.sh [BUILD_DIR]
@@ -17,7 +17,7 @@ for name in soft_shadows focal_blur glossy_reflection horizon_texture media thin
 	hdr_highlights; do
 	ref=$(ls "$CACHE/$name-160x120-s25-"*.exr 2>/dev/null | head -n 1)
 	[[ -n $ref ]] || { echo "final_modes: no reference for $name (run make sweep)" >&2; exit 1; }
-	for mode in samples auto reconstruction; do
+	for mode in samples blend auto reconstruction; do
 		"$PP" render "$ROOT/scenes/$name.pov" -o "$T/o.exr" -W 160 -H 120 --target 1e-3 \
 			--final "$mode" --jobs 4 -q -- +WT1
 		printf '%-18s %-14s %s\n' "$name" "$mode" \
