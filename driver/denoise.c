@@ -28,7 +28,7 @@ void denoise_params_init(struct denoise_params *p)
 {
 	p->radius = 3;
 	p->patch = 2;
-	p->k = 1.5;
+	p->k = 0.75;
 	p->nthreads = 0;
 }
 

@@ -192,15 +192,16 @@ if [[ -d $T/glossy_reflection.work && -f $T/glossy_reflection.exr ]]; then
 		num 'a < 0.75 * b' "${auto:-1}" "${samples:-0}"
 	# the blend unfiltered (--final blend): the filter of --final auto
 	# (driver/denoise.c) takes a share of its error on the same samples
-	# (measured 0.68 to 0.75 of it on glossy_reflection at 160x120)
+	# (0.76 to 0.78 of it on glossy_reflection at 160x120, 4 runs; 0.88 at
+	# this test's 80x60, 3 runs)
 	cp -r "$T/glossy_reflection.work" "$T/gb.work"
 	"$PP" render "$SC/glossy_reflection.pov" -o "$T/gb.exr" -W $W -H $H --target 1 \
 		--final blend -q --workdir "$T/gb.work" --resume
 	check "final blend: the work directory finished again" test $? -eq 0
 	blend=$(relmse "$T/gb.exr" "$ref")
 	echo "# glossy_reflection: --final blend $blend"
-	check "final auto: under 0.9 x the unfiltered blend's relMSE on the same samples" \
-		num 'a < 0.9 * b' "${auto:-1}" "${blend:-0}"
+	check "final auto: under 0.95 x the unfiltered blend's relMSE on the same samples" \
+		num 'a < 0.95 * b' "${auto:-1}" "${blend:-0}"
 	check "final blend: under the samples' mean's relMSE" \
 		num 'a < b' "${blend:-1}" "${samples:-0}"
 	partial=$(oiiotool "$T/glossy_reflection.errors.exr" --ch fit --mulc 2 --subc 1 --abs \
