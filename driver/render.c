@@ -233,6 +233,11 @@ struct run {
 	double pre_latency;	/* an early render's wait from its gate to its
 				 * image, less its CPU (measured; PRE_LATENCY
 				 * until then) */
+	double write_s;		/* the last pass's writes of its work directory
+				 * and image, wall seconds (final_reserve()) */
+	double renders_end;	/* when the last pass's renders ended (now_s()) */
+	double tail_s;		/* from then to the end of its writes: merges,
+				 * analysis, writes (0: no region pass yet) */
 };
 
 static void print_usage(FILE *f)
@@ -1302,6 +1307,26 @@ static int one_step(const struct run *r, int *sparse)
 }
 
 /*
+ * What a pass keeps of the budget after its renders, wall seconds: what
+ * the last region pass took from its renders' end to its image written
+ * (merging the renders, the analysis, the writes; before the first, the
+ * base pass's analysis and writes), then the final stage: under --final
+ * auto the filter (measured at 0.3 to 0.45 of an analysis: 0.14 s against
+ * 0.28 to 0.45 s at 640x480 on two cores, 2026-11-23), the error map
+ * beside the image (as long again as the pass's writes), and 0.1 s.  With
+ * the analysis and 0.1 s alone, soft_shadows at 640x480 under --budget 4
+ * ended at 4.2 s without the filter, 4.35 to 4.6 s with it (the final
+ * stage 0.4 s, the merges 0.13 s).
+ */
+#define FILTER_SHARE 0.5
+static double final_reserve(const struct run *r)
+{
+	const double a = r->passes[r->npasses - 1].analysis_s;
+	const double tail = r->tail_s > 0.0 ? r->tail_s : a + r->write_s;
+	return tail + (r->filter ? FILTER_SHARE * a : 0.0) + r->write_s + 0.1;
+}
+
+/*
  * One refinement pass from the error estimate r->est.  Returns 0 when a
  * pass ran, PASS_STOP when the planner stopped the run (r->stop says why),
  * -1 on failure, POV_INTERRUPTED when a signal came.
@@ -1310,9 +1335,9 @@ enum { PASS_STOP = 2 };
 static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 {
 	double t = now_s(), c = self_cpu();
-	/* what a pass keeps of the budget after its renders: the time of the
-	 * last analysis and 0.1 s; its renders' deadline is the rest */
-	const double reserve = r->passes[r->npasses - 1].analysis_s + 0.1;
+	/* what a pass keeps of the budget after its renders; its renders'
+	 * deadline is the rest */
+	const double reserve = final_reserve(r);
 	int sparse = -1;	/* sparse_error(), once a pass asks */
 	const int choose = !r->jittered && one_step(r, &sparse);
 	int fit = 2;	/* passes that still fit the budget, this one included */
@@ -1463,6 +1488,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	progress(r, "pass %d: %zu regions, %ld pixels (%ld chosen), %.0f samples, about %.1f s",
 		 pass, n, pl.pixels, pl.chosen_pixels, pl.samples, guess + r->latency);
 	int rc = pov_pool_run(jobs, n, &po, results, err, errlen);
+	r->renders_end = now_s();
 	struct pass_rec p = {0};
 	p.prelaunched = (int)pov_prelaunch_taken(pre);
 	p.cpu_s = pre_cpu + pov_prelaunch_end(pre);
@@ -1858,9 +1884,13 @@ bad:
 		last->est_relmse = est;
 		last->analysis_s = now_s() - ta;
 		last->wall_s += last->analysis_s;
+		double tw = now_s();
 		if (save_progress(&r, err, sizeof err) ||
 		    write_output(&r, &res, 0, NULL, err, sizeof err))
 			goto fail;
+		r.write_s = now_s() - tw;
+		if (r.renders_end > 0.0)
+			r.tail_s = now_s() - r.renders_end;
 		double el = elapsed(&r);
 		if (r.budget > 0.0)
 			progress(&r, "pass %d: estimated relMSE %.3g (target %.3g), %ld pixels above "
