@@ -52,8 +52,12 @@ static double term(const struct band *b, int x, int y, int dx, int dy, double k2
 	const float *a = b->rgb + 3 * ((size_t)y * b->w + x), *q = b->rgb + 3 * ((size_t)qy * b->w + qx);
 	const float *va = b->var + 3 * ((size_t)y * b->w + x), *vq = b->var + 3 * ((size_t)qy * b->w + qx);
 	double t = 0.0;
+	/* a value that is not finite (a hole no fit reached) is no one's
+	 * neighbour */
 	for (int c = 0; c < 3; c++) {
 		double d = (double)a[c] - q[c], vm = va[c] < vq[c] ? va[c] : vq[c];
+		if (!isfinite(d))
+			return HUGE_VAL;
 		double s = (d * d - (va[c] + vm)) /
 			   (2.0 * k2 * vm + TERM_EPS * ((double)a[c] * a[c] + METRICS_RELMSE_EPS));
 		t += s > TERM_FLOOR ? s : TERM_FLOOR;
@@ -109,6 +113,9 @@ static void *run_band(void *arg)
 						continue;
 					const double wt = d > 0.0 ? exp(-d) : 1.0;
 					const size_t i = (size_t)j * w + x, q = (size_t)qy * w + qx;
+					if (!isfinite(b->rgb[3 * q]) || !isfinite(b->rgb[3 * q + 1]) ||
+					    !isfinite(b->rgb[3 * q + 2]))
+						continue;
 					for (int c = 0; c < 3; c++) {
 						num[3 * i + c] += wt * b->rgb[3 * q + c];
 						v2[3 * i + c] += wt * wt * b->var[3 * q + c];
@@ -123,7 +130,18 @@ static void *run_band(void *arg)
 		for (int x = 0; x < w; x++) {
 			const size_t i = (size_t)j * w + x, g = (size_t)(b->y0 + j) * w + x;
 			/* the pixel's own weight is 1 (its distance to itself is
-			 * at most 0), so den >= 1 */
+			 * at most 0), so den >= 1, unless its value is not
+			 * finite: then it stays as it is */
+			if (!(den[i] > 0.0)) {
+				for (int c = 0; c < 3; c++) {
+					b->out[3 * g + c] = b->rgb[3 * g + c];
+					if (b->vout)
+						b->vout[3 * g + c] = b->var[3 * g + c];
+				}
+				if (b->self)
+					b->self[g] = 1.0f;
+				continue;
+			}
 			for (int c = 0; c < 3; c++) {
 				b->out[3 * g + c] = (float)(num[3 * i + c] / den[i]);
 				if (b->vout)

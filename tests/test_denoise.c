@@ -183,6 +183,24 @@ static void test_noise_free_unchanged(void **state)
 		assert_true(fabs(s.out[i] - s.noisy[i]) <= 1e-3 * fabs(s.noisy[i]));
 }
 
+/* A hole (a value that is not finite) stays a hole and spreads to no
+ * neighbour. */
+static void test_hole_not_spread(void **state)
+{
+	(void)state;
+	static struct scene s;
+	make(&s, flat, sigma05);
+	const size_t h = (size_t)10 * W + 10;
+	for (int c = 0; c < 3; c++)
+		s.noisy[3 * h + c] = NAN;
+	filter(&s, 1);
+	assert_true(isnan(s.out[3 * h]));
+	for (size_t i = 0; i < NPX * 3; i++)
+		if (i / 3 != h)
+			assert_true(isfinite(s.out[i]) && isfinite(s.vout[i]));
+	assert_true(mse(&s, s.out, 12, W) < 0.25 * mse(&s, s.noisy, 12, W));
+}
+
 /* Bands on threads give the same image as one band. */
 static void test_threads_same(void **state)
 {
@@ -222,6 +240,7 @@ int main(void)
 		cmocka_unit_test(test_step_edge_kept),
 		cmocka_unit_test(test_star_kept),
 		cmocka_unit_test(test_noise_free_unchanged),
+		cmocka_unit_test(test_hole_not_spread),
 		cmocka_unit_test(test_threads_same),
 		cmocka_unit_test(test_bad_input),
 	};
