@@ -485,16 +485,19 @@ done
 # --- a budget is a deadline: a pass planned far over it is stopped in time ----
 # --cost-sample 1e-9: the planner thinks samples free and plans a pass that
 # would take many times the budget (--prelaunch off: a pass that takes
-# renders started early leaves its dearer regions to the next)
+# renders started early leaves its dearer regions to the next).  4 s: the
+# second pass, the one planned free, starts when the first ends by about
+# 2 s (at 3 s one fresh-clone run in three ended after the first pass, by
+# the measured reserve, and stopped nothing)
 t0=$EPOCHREALTIME
-"$PP" render "$SC/media.pov" -o "$T/dl.exr" -W 80 -H 60 --budget 3 --target 1e-6 \
+"$PP" render "$SC/media.pov" -o "$T/dl.exr" -W 80 -H 60 --budget 4 --target 1e-6 \
 	--cost-sample 1e-9 --prelaunch off --workdir "$T/dl work" -v 2>"$T/dl.err"
 rc=$?
 dt=$(awk -v a="$t0" -v b="$EPOCHREALTIME" 'BEGIN { printf "%.2f", b - a }')
 check "budget deadline: a run whose pass is planned as free succeeds" test $rc -eq 0
 check "... its region renders are stopped at the budget's end" \
 	grep -q "stopped at the budget's end" "$T/dl.err"
-check "... and it ends within the 3 s budget ($dt s)" num 'a <= 3.3' "$dt"
+check "... and it ends within the 4 s budget ($dt s)" num 'a <= 4.3' "$dt"
 check "... the output is a complete image" valid_exr "$T/dl.exr"
 check "... no POV-Ray child left" no_povray_left "$T/dl work"
 
