@@ -487,7 +487,7 @@ done
 # would take many times the budget (--prelaunch off: a pass that takes
 # renders started early leaves its dearer regions to the next).  4 s: the
 # second pass, the one planned free, starts when the first ends by about
-# 2 s (at 3 s one fresh-clone run in three ended after the first pass, by
+# 2 s (at 3 s one of two fresh-clone runs ended after the first pass, by
 # the measured reserve, and stopped nothing)
 t0=$EPOCHREALTIME
 "$PP" render "$SC/media.pov" -o "$T/dl.exr" -W 80 -H 60 --budget 4 --target 1e-6 \
