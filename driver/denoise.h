@@ -22,7 +22,7 @@
  * Pixels with V = 0 all round take only neighbours equal to them within
  * about 0.1%.  k = 0.75 rather than 1.5: the larger took 2% more error off
  * the bundled scenes but blurred texture as faint as the noise (Debian's
- * woodbox: 1.25 times the unfiltered error; see the README).
+ * woodbox: 1.24 times the unfiltered error; see the README).
  */
 #ifndef POVPRESS_DENOISE_H
 #define POVPRESS_DENOISE_H

@@ -1316,7 +1316,7 @@ static int one_step(const struct run *r, int *sparse)
  * 0.28 to 0.45 s at 640x480 on two cores, 2026-11-23), the error map
  * beside the image (as long again as the pass's writes), and 0.1 s.  With
  * the analysis and 0.1 s alone, soft_shadows at 640x480 under --budget 4
- * ended at 4.2 s without the filter, 4.35 to 4.6 s with it (the final
+ * ended at 4.2 s without the filter, 4.4 to 4.6 s with it (the final
  * stage 0.4 s, the merges 0.13 s).
  */
 #define FILTER_SHARE 0.5
