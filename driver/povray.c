@@ -1743,8 +1743,8 @@ static unsigned gate_serial;	/* gates' names, unique in the process */
 struct pov_prelaunch {
 	struct pjob *pj;	/* the jobs; pid 0 once taken or stopped */
 	size_t n, taken;
-	char **gate;		/* the gates' paths */
-	int *argc;		/* each command's length without +HI */
+	char **gate;		/* the gates' paths (+HI, each command's last
+				 * argument) */
 	double cpu_s;		/* of the stopped ones */
 };
 
@@ -1792,7 +1792,6 @@ double pov_prelaunch_end(struct pov_prelaunch *pre)
 	double cpu = pre->cpu_s;
 	free(pre->pj);
 	free(pre->gate);
-	free(pre->argc);
 	free(pre);
 	return cpu;
 }
@@ -1824,13 +1823,8 @@ int pov_prelaunch_start(const struct pov_job *jobs, size_t njobs, const char *ga
 	}
 	struct pov_prelaunch *pre = calloc(1, sizeof(*pre));
 	if (!pre || !(pre->pj = calloc(njobs ? njobs : 1, sizeof(*pre->pj))) ||
-	    !(pre->gate = calloc(njobs ? njobs : 1, sizeof(*pre->gate))) ||
-	    !(pre->argc = calloc(njobs ? njobs : 1, sizeof(*pre->argc)))) {
-		if (pre) {
-			free(pre->pj);
-			free(pre->gate);
-		}
-		free(pre);
+	    !(pre->gate = calloc(njobs ? njobs : 1, sizeof(*pre->gate)))) {
+		pov_prelaunch_end(pre);	/* n is still 0 */
 		errbuf_printf(err, errlen, "out of memory");
 		return -1;
 	}
@@ -1852,7 +1846,6 @@ int pov_prelaunch_start(const struct pov_job *jobs, size_t njobs, const char *ga
 		if (pov_find_binary(&jobs[k], bin, sizeof(bin), err, errlen) ||
 		    cmd_build(&jobs[k], &j->cmd, err, errlen))
 			goto fail;
-		pre->argc[k] = j->cmd.argc;
 		pre->gate[k] = xprintf("%s/gate-%u.inc", gatedir, ++gate_serial);
 		j->bin = strdup(bin);
 		if (!pre->gate[k] || !j->bin ||
@@ -1894,7 +1887,7 @@ static int prelaunch_matches(const struct pov_prelaunch *pre, size_t k, const st
 {
 	const struct cmd *q = &pre->pj[k].cmd;
 
-	if (pre->pj[k].pid <= 0 || pre->argc[k] != c->argc)
+	if (pre->pj[k].pid <= 0 || q->argc - 1 != c->argc)
 		return 0;
 	for (int i = 0; i < c->argc; i++)
 		if (strcmp(q->argv[i], c->argv[i]))

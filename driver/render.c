@@ -521,10 +521,12 @@ static int final_image(struct run *r, const struct lpr_result *res, int filter, 
 	accum_final_image(&r->acc, res->fit, r->take, out->px);
 	if (!filter)
 		return 0;
+	/* the filtered noise and each pixel's own weight only for est */
 	float *var = malloc(npx * 3 * sizeof(float)), *f = malloc(npx * 3 * sizeof(float));
-	float *vf = malloc(npx * 3 * sizeof(float)), *self = malloc(npx * sizeof(float));
+	float *vf = est ? malloc(npx * 3 * sizeof(float)) : NULL;
+	float *self = est ? malloc(npx * sizeof(float)) : NULL;
 	int rc = -1;
-	if (!var || !f || !vf || !self) {
+	if (!var || !f || (est && (!vf || !self))) {
 		errbuf_printf(err, errlen, "out of memory filtering the final image");
 		goto out;
 	}
@@ -536,9 +538,10 @@ static int final_image(struct run *r, const struct lpr_result *res, int filter, 
 	}
 	struct denoise_params dp;
 	denoise_params_init(&dp);
+	dp.nthreads = r->cores;
 	if (denoise_nlm(r->w, r->h, out->px, var, &dp, f, vf, self, err, errlen))
 		goto out;
-	for (size_t i = 0; est && i < npx; i++) {
+	for (size_t i = 0; est && i < npx; i++) {	/* est: the estimate follows */
 		double u = 0.0, vn = 0.0, sure = 0.0;
 		for (int c = 0; c < 3; c++) {
 			double b = out->px[3 * i + c], s = b * b + METRICS_RELMSE_EPS;
