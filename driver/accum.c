@@ -11,6 +11,7 @@
 
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 const int accum_scales[ACC_NSCALES] = { 1, 2, 4, 8, 16 };
@@ -277,53 +278,164 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 	return count;
 }
 
+/*
+ * The twist of four quadrant means q (in the order top-left, top-right,
+ * bottom-left, bottom-right): (q0 - q1 - q2 + q3) / 4 per channel,
+ * squared, relative to mean^2 + 0.01, mean over R, G, B.  The samples of a
+ * region render are stratified by quadrant, so their mean's error is the
+ * mean of the quadrants' errors; the twist has the same variance under
+ * noise and no part of a linear change across the pixel (an edge or a
+ * curve through it adds to it, so it errs high).  NaN when not finite.
+ */
+static double quad_twist(double q[4][3], const double mean[3])
+{
+	double v[3];
+	for (int c = 0; c < 3; c++) {
+		double t = (q[0][c] - q[1][c] - q[2][c] + q[3][c]) / 4.0;
+		v[c] = t * t;
+	}
+	double r = 0.0;
+	for (int c = 0; c < 3; c++)
+		r += v[c] / (mean[c] * mean[c] + METRICS_RELMSE_EPS) / 3.0;
+	return isfinite(r) ? r : NAN;
+}
+
+/*
+ * The 'diff' of a fold of nb new samples onto na (accum_fold()) takes both
+ * means as independent samples' (each of variance sigma^2 / n), so the
+ * difference between them d2 gives the merged mean's sigma^2 / (na + nb).
+ * A region render's samples are stratified: where the pixel varies across
+ * its area (an edge, a texture, a penumbra's slope) their mean is far
+ * closer than sigma^2 / nb, and the base pass's one sample at the centre
+ * is the one that differs.  With vb, the new mean's own squared error
+ * (quad_twist() smoothed), the old mean's is d2 - vb, and the merged
+ * mean's (na^2 (d2 - vb) + nb^2 vb) / (na + nb)^2: the diff is that where
+ * it is smaller.  Pixel i has folded; old is its mean before, mean the new
+ * samples'.
+ */
+static void strat_diff(struct image *acc, size_t i, const double old[3], double na,
+		       const double mean[3], double nb, double vb)
+{
+	float *o = acc->px + i * ACC_NCH;
+	if (!(na > 0.0) || !(nb > 0.0) || !isfinite(vb) || !isfinite(o[ACC_DIFF]))
+		return;
+	double e2[3];
+	for (int c = 0; c < 3; c++)
+		e2[c] = (mean[c] - old[c]) * (mean[c] - old[c]);
+	double d2 = rel3(o, e2), nt = na + nb;
+	double va = d2 > vb ? d2 - vb : 0.0;
+	double st = (na * na * va + nb * nb * vb) / (nt * nt);
+	if (isfinite(st) && st < o[ACC_DIFF])
+		o[ACC_DIFF] = (float)st;
+}
+
+/* The quad_twist() of a region's pixels (tw, rw x rh, NaN where none)
+ * smoothed by the mean over the 3 x 3 pixels around each that have one
+ * (one pixel's is one number's square: about a degree of freedom), into
+ * out. */
+static void twist_smooth(const double *tw, int rw, int rh, double *out)
+{
+	for (int y = 0; y < rh; y++)
+		for (int x = 0; x < rw; x++) {
+			double sum = 0.0;
+			int n = 0;
+			for (int j = y - 1; j <= y + 1; j++)
+				for (int k = x - 1; k <= x + 1; k++) {
+					if (j < 0 || j >= rh || k < 0 || k >= rw)
+						continue;
+					double t = tw[(size_t)j * rw + k];
+					if (isfinite(t)) {
+						sum += t;
+						n++;
+					}
+				}
+			out[(size_t)y * rw + x] = isfinite(tw[(size_t)y * rw + x]) && n ? sum / n : NAN;
+		}
+}
+
+/* Pixel (x, y) of a grid render: its sub-pixels' values (sub, nq of them
+ * finite; in the quadrant order of quad_twist() when all 4 are), their
+ * mean, sum of squared deviations m2 and count of samples each (*g). */
+static int grid_pixel(const struct image *acc, const struct image *img, int oy, const int ch[3],
+		      int s, int x, int y, double sub[4][3], double mean[3], double m2[3], int *g)
+{
+	const int f = ACC_GRID_FRAME, g0 = accum_grid_samples(s) / 4;	/* per sub-pixel */
+	size_t i = (size_t)y * acc->w + x;
+	const float *o = acc->px + i * ACC_NCH;
+	int nq = 0;
+	/* a sub-pixel's centre sample repeats scale 2's where the pixel has
+	 * it: taken out, by the pixel's mean in its place */
+	const int dup = accum_has_scale(acc, i, 2) && o[ACC_SAMPLES] > 0.0f;
+	*g = dup ? g0 - 1 : g0;
+	for (int c = 0; c < 3; c++)
+		mean[c] = 0.0;
+	for (int j = 0; j < f; j++)
+		for (int l = 0; l < f; l++) {
+			const float *p = img->px +
+				((size_t)(y * f + j - oy) * img->w + (size_t)x * f + l) * img->nch;
+			if (!isfinite(p[ch[0]]) || !isfinite(p[ch[1]]) || !isfinite(p[ch[2]]))
+				continue;
+			for (int c = 0; c < 3; c++) {
+				sub[nq][c] = dup ? (g0 * (double)p[ch[c]] - o[c]) / *g : p[ch[c]];
+				mean[c] += sub[nq][c];
+			}
+			nq++;
+		}
+	for (int c = 0; c < 3; c++) {
+		mean[c] = nq ? mean[c] / nq : 0.0;
+		double b = 0.0;
+		for (int q = 0; q < nq; q++)
+			b += (sub[q][c] - mean[c]) * (sub[q][c] - mean[c]);
+		/* per sample: what the sub-pixels' spread means for noise,
+		 * capped by the pixel's own sample variance */
+		double v = nq > 1 ? *g * b / (nq - 1) : NAN;
+		double own = o[ACC_SAMPLES] >= 2.0f ? (double)o[ACC_VAR_R + c] : NAN;
+		if (!isfinite(v) || (isfinite(own) && own < v))
+			v = own;
+		m2[c] = *g * b + (isfinite(v) ? nq * (*g - 1) * v : 0.0);
+	}
+	return nq;
+}
+
 /* Fold a grid render (ACC_GRID_FRAME; see accum_merge_region()). */
 static long merge_grid(struct image *acc, const struct image *img, int oy, const int ch[3],
 		       int s, int x0, int y0, int x1, int y1, int pass)
 {
-	const int f = ACC_GRID_FRAME, g0 = accum_grid_samples(s) / 4;	/* per sub-pixel */
+	const int rw = x1 - x0 + 1, rh = y1 - y0 + 1;
+	const size_t rn = (size_t)rw * rh;
 	long count = 0;
+	/* the new means' own errors (strat_diff()); without the memory the
+	 * diff is the independent samples' */
+	double *tw = malloc(2 * rn * sizeof(*tw)), *sm = tw ? tw + rn : NULL;
+	if (tw) {
+		for (int y = y0; y <= y1; y++)
+			for (int x = x0; x <= x1; x++) {
+				double sub[4][3], mean[3], m2[3];
+				int g;
+				size_t k = (size_t)(y - y0) * rw + (x - x0);
+				tw[k] = NAN;
+				if (accum_has_scale(acc, (size_t)y * acc->w + x, s))
+					continue;
+				if (grid_pixel(acc, img, oy, ch, s, x, y, sub, mean, m2, &g) == 4)
+					tw[k] = quad_twist(sub, mean);
+			}
+		twist_smooth(tw, rw, rh, sm);
+	}
 	for (int y = y0; y <= y1; y++)
 		for (int x = x0; x <= x1; x++) {
 			size_t i = (size_t)y * acc->w + x;
 			const float *o = acc->px + i * ACC_NCH;
-			double sub[4][3], mean[3] = { 0.0, 0.0, 0.0 }, m2[3];
-			int nq = 0;
-			/* a sub-pixel's centre sample repeats scale 2's where the
-			 * pixel has it: taken out, by the pixel's mean in its place */
-			const int dup = accum_has_scale(acc, i, 2) && o[ACC_SAMPLES] > 0.0f;
-			const int g = dup ? g0 - 1 : g0;
-			for (int j = 0; j < f; j++)
-				for (int l = 0; l < f; l++) {
-					const float *p = img->px +
-						((size_t)(y * f + j - oy) * img->w + (size_t)x * f + l) *
-						img->nch;
-					if (!isfinite(p[ch[0]]) || !isfinite(p[ch[1]]) ||
-					    !isfinite(p[ch[2]]))
-						continue;
-					for (int c = 0; c < 3; c++) {
-						sub[nq][c] = dup ? (g0 * (double)p[ch[c]] - o[c]) / g
-								 : p[ch[c]];
-						mean[c] += sub[nq][c];
-					}
-					nq++;
-				}
-			for (int c = 0; c < 3; c++) {
-				mean[c] = nq ? mean[c] / nq : 0.0;
-				double b = 0.0;
-				for (int q = 0; q < nq; q++)
-					b += (sub[q][c] - mean[c]) * (sub[q][c] - mean[c]);
-				/* per sample: what the sub-pixels' spread means for
-				 * noise, capped by the pixel's own sample variance */
-				double v = nq > 1 ? g * b / (nq - 1) : NAN;
-				double own = o[ACC_SAMPLES] >= 2.0f ? (double)o[ACC_VAR_R + c] : NAN;
-				if (!isfinite(v) || (isfinite(own) && own < v))
-					v = own;
-				m2[c] = g * b + (isfinite(v) ? nq * (g - 1) * v : 0.0);
-			}
-			if (!accum_fold(acc, i, s, nq * g, mean, m2, pass) && nq)
-				count++;
+			double sub[4][3], mean[3], m2[3], old[3] = { o[0], o[1], o[2] };
+			double na = o[ACC_SAMPLES];
+			int g, nq = grid_pixel(acc, img, oy, ch, s, x, y, sub, mean, m2, &g);
+			if (accum_fold(acc, i, s, nq * g, mean, m2, pass) || !nq)
+				continue;
+			count++;
+			if (sm)
+				strat_diff(acc, i, old, na, mean, (double)nq * g,
+					   sm[(size_t)(y - y0) * rw + (x - x0)]);
 		}
+	free(tw);
 	return count;
 }
 
@@ -342,6 +454,48 @@ static int render_frame(int s, int render_w, int image_w)
 {
 	return may_double(s) && render_w == image_w * ACC_GRID_FRAME ? ACC_GRID_FRAME
 								     : accum_render_factor(s);
+}
+
+/* Pixel (x, y) of a render s times the image's size: the mean of its
+ * s x s finite samples, their sum of squared deviations m2, and for an even
+ * s the means of its four (s/2) x (s/2) quadrants q (in quad_twist()'s
+ * order; meaningful when all samples are finite).  Returns the count. */
+static int scaled_pixel(const struct image *img, int oy, const int ch[3], int s, int x, int y,
+			double mean[3], double m2[3], double q[4][3])
+{
+	double sum[3] = { 0.0, 0.0, 0.0 };
+	int n = 0;
+	for (int k = 0; k < 4; k++)
+		for (int c = 0; c < 3; c++)
+			q[k][c] = 0.0;
+	for (int pass2 = 0; pass2 < 2; pass2++) {
+		for (int j = 0; j < s; j++) {
+			const float *row = img->px +
+				((size_t)(y * s + j - oy) * img->w + (size_t)x * s) * img->nch;
+			for (int k = 0; k < s; k++) {
+				const float *p = row + (size_t)k * img->nch;
+				if (!isfinite(p[ch[0]]) || !isfinite(p[ch[1]]) || !isfinite(p[ch[2]]))
+					continue;
+				const int quad = (2 * j >= s) * 2 + (2 * k >= s);
+				for (int c = 0; c < 3; c++) {
+					if (!pass2) {
+						sum[c] += p[ch[c]];
+						q[quad][c] += p[ch[c]] * 4.0 / ((double)s * s);
+					} else {
+						double d = p[ch[c]] - mean[c];
+						m2[c] += d * d;
+					}
+				}
+				n += !pass2;
+			}
+		}
+		if (!pass2)
+			for (int c = 0; c < 3; c++) {
+				mean[c] = n ? sum[c] / n : 0.0;
+				m2[c] = 0.0;
+			}
+	}
+	return n;
 }
 
 int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
@@ -391,41 +545,39 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 			*folded = c;
 		return 0;
 	}
+	const int rw = x1 - x0 + 1, rh = y1 - y0 + 1;
+	const size_t rn = (size_t)rw * rh;
+	/* as merge_grid()'s: the quadrants of an even scale's s x s */
+	double *tw = s % 2 == 0 ? malloc(2 * rn * sizeof(*tw)) : NULL, *sm = tw ? tw + rn : NULL;
+	if (tw) {
+		for (int y = y0; y <= y1; y++)
+			for (int x = x0; x <= x1; x++) {
+				double mean[3], m2[3], q[4][3];
+				int n = scaled_pixel(img, oy, ch, s, x, y, mean, m2, q);
+				size_t k = (size_t)(y - y0) * rw + (x - x0);
+				tw[k] = n == s * s && !accum_has_scale(acc, (size_t)y * acc->w + x, s)
+						? quad_twist(q, mean)
+						: NAN;
+			}
+		twist_smooth(tw, rw, rh, sm);
+	}
 	long count = 0;
 	for (int y = y0; y <= y1; y++) {
 		for (int x = x0; x <= x1; x++) {
-			double sum[3] = {0}, mean[3], m2[3] = {0};
-			int n = 0;
-			for (int pass2 = 0; pass2 < 2; pass2++) {
-				for (int j = 0; j < s; j++) {
-					const float *row = img->px +
-						((size_t)(y * s + j - oy) * img->w + (size_t)x * s) *
-						img->nch;
-					for (int k = 0; k < s; k++) {
-						const float *p = row + (size_t)k * img->nch;
-						if (!isfinite(p[ch[0]]) || !isfinite(p[ch[1]]) ||
-						    !isfinite(p[ch[2]]))
-							continue;
-						for (int c = 0; c < 3; c++) {
-							if (!pass2) {
-								sum[c] += p[ch[c]];
-							} else {
-								double d = p[ch[c]] - mean[c];
-								m2[c] += d * d;
-							}
-						}
-						n += !pass2;
-					}
-				}
-				if (!pass2)
-					for (int c = 0; c < 3; c++)
-						mean[c] = n ? sum[c] / n : 0.0;
-			}
+			double mean[3], m2[3], q[4][3];
+			int n = scaled_pixel(img, oy, ch, s, x, y, mean, m2, q);
 			size_t i = (size_t)y * acc->w + x;
-			if (!accum_fold(acc, i, s, n, mean, m2, pass) && n)
-				count++;
+			const float *o = acc->px + i * ACC_NCH;
+			double old[3] = { o[0], o[1], o[2] }, na = o[ACC_SAMPLES];
+			if (accum_fold(acc, i, s, n, mean, m2, pass) || !n)
+				continue;
+			count++;
+			if (sm)
+				strat_diff(acc, i, old, na, mean, n,
+					   sm[(size_t)(y - y0) * rw + (x - x0)]);
 		}
 	}
+	free(tw);
 	if (folded)
 		*folded = count;
 	return 0;

@@ -153,9 +153,11 @@ int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
  * centre sample out, see ACC_GRID_FRAME); the pixel takes their mean, the
  * spread between them, and within them the per-sample spread their spread
  * implies for noise, but not more than the pixel's samples had so far
- * (spread between the sub-pixels can be an edge's, not noise).  *folded
- * counts the pixels that took new samples (may be NULL).  Fails on a size
- * mismatch or rows not read.
+ * (spread between the sub-pixels can be an edge's, not noise).  The
+ * fold's difference (the 'diff' channel) is lowered where the new samples'
+ * quadrants agree (their mean is closer than independent samples' would
+ * be: see strat_diff() in accum.c).  *folded counts the pixels that took
+ * new samples (may be NULL).  Fails on a size mismatch or rows not read.
  */
 int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
 		       int y0, int x1, int y1, int pass, long *folded, char *err,

@@ -371,6 +371,53 @@ static void test_merge_grid(void **state)
 	image_release(&acc);
 }
 
+/*
+ * The fold difference of a region render's stratified samples: onto one
+ * base sample at 0.5, pixels whose four sub-pixels agree at 0.3 (no
+ * twist: the new mean exact) have the old sample's difference charged at
+ * its own weight, d2 / nt^2, not the independent samples' d2 nb / nt^2;
+ * a pixel whose sub-pixels twist (0.5 and 0.1 crosswise) keeps the
+ * independent figure, and so does its neighbour, whose 3 x 3 mean takes a
+ * third of the twist (weighed by nb^2 it outweighs d2).  Grid renders (scale 4, 5 samples a
+ * sub-pixel) and resolution scaling (scale 2, one sample a quadrant) alike.
+ */
+static void test_merge_stratified(void **state)
+{
+	const int W = 5, H = 1;
+	(void)state;
+	for (int kind = 0; kind < 2; kind++) {
+		const int s = kind ? 2 : 4;
+		const double nb = kind ? 4.0 : 20.0, nt = nb + 1.0;
+		struct image acc, r;
+		char err[256];
+		long folded = -1;
+		make_acc(&acc, W, H, flat_value);
+		assert_int_equal(image_init(&r, 2 * W, 2 * H, 3, rgb_names, err, sizeof(err)), 0);
+		for (int x = 0; x < W; x++)
+			for (int j = 0; j < 2; j++)
+				for (int l = 0; l < 2; l++) {
+					double v = x == W - 1 ? (j == l ? 0.5 : 0.1) : 0.3;
+					for (int c = 0; c < 3; c++)
+						r.px[((size_t)j * r.w + 2 * x + l) * 3 + c] = (float)v;
+				}
+		assert_int_equal(accum_merge_region(&acc, &r, 0, s, 0, 0, W - 1, 0, 1, &folded,
+						    err, sizeof(err)),
+				 0);
+		assert_int_equal(folded, W);
+		for (int x = 0; x < W; x++) {
+			const float *o = accpx(&acc, (size_t)x);
+			double mt = (0.5 + nb * 0.3) / nt, d2 = 0.04 / (mt * mt + 0.01);
+			double iid = d2 * nb / (nt * nt), own = d2 / (nt * nt);
+			char what[64];
+			snprintf(what, sizeof(what), "scale %d pixel %d diff", s, x);
+			/* the twisted pixel's mean is 0.3 too */
+			assert_close(o[ACC_DIFF], x < W - 2 ? own : iid, 1e-4, 0.0, what);
+		}
+		image_release(&r);
+		image_release(&acc);
+	}
+}
+
 /* 2. accum_merge_region: block statistics, untouched outside, errors. */
 static void test_merge_region(void **state)
 {
@@ -1619,6 +1666,7 @@ int main(void)
 		cmocka_unit_test(test_merge_nonfinite),
 		cmocka_unit_test(test_merge_aa),
 		cmocka_unit_test(test_merge_grid),
+		cmocka_unit_test(test_merge_stratified),
 		cmocka_unit_test(test_accum_read),
 		cmocka_unit_test(test_read_rows),
 		cmocka_unit_test(test_plan_make),
