@@ -127,18 +127,9 @@ static int by_score(const void *a, const void *b)
 	return x->i < y->i ? -1 : x->i > y->i;	/* stable: the same plan every run */
 }
 
-/* The rays a pixel of a w x h image costs at scale s: a grid render traces
- * accum_grid_samples(s) (its s x s jittered samples and the 4 sub-pixels'
- * centres), resolution scaling s^2. */
-static double scale_rays(const struct plan_params *p, int w, int h, int s)
+static double rect_cost(const struct plan_params *p, const struct plan_region *r)
 {
-	return plan_grid_scale(p, w, h, s) ? (double)accum_grid_samples(s) : (double)s * s;
-}
-
-static double rect_cost(const struct plan_params *p, const struct plan_region *r, int w, int h)
-{
-	return p->cost_job +
-	       p->cost_sample * (double)plan_region_area(r) * scale_rays(p, w, h, r->scale);
+	return p->cost_job + p->cost_sample * (double)plan_region_area(r) * r->scale * r->scale;
 }
 
 static void bbox(const struct plan_region *a, const struct plan_region *b,
@@ -265,8 +256,7 @@ static int pack(const struct plan_params *p, int w, int h, int s, const unsigned
 			for (size_t b = a + 1; b < n; b++) {
 				struct plan_region m;
 				bbox(&r[a], &r[b], &m);
-				double d = rect_cost(p, &m, w, h) - rect_cost(p, &r[a], w, h) -
-					   rect_cost(p, &r[b], w, h);
+				double d = rect_cost(p, &m) - rect_cost(p, &r[a]) - rect_cost(p, &r[b]);
 				if (d < best) {
 					best = d;
 					ba = a;
@@ -292,7 +282,7 @@ static int pack(const struct plan_params *p, int w, int h, int s, const unsigned
 		}
 	}
 	for (size_t k = 0; k < n; k++)
-		r[k].cost = rect_cost(p, &r[k], w, h);
+		r[k].cost = rect_cost(p, &r[k]);
 	if (n) {
 		void *q = realloc(*rs, (*nrs + n) * sizeof(**rs));
 		if (!q)
@@ -405,15 +395,14 @@ static int next_upgrade(const struct plan_params *p, const struct image *acc, si
 	u->i = i;
 	u->to = to;
 	u->gain = e * (m2 / (n + m2) - m1 / (n + m1));
-	u->cost = p->cost_sample * (scale_rays(p, acc->w, acc->h, to) -
-				    (cur ? scale_rays(p, acc->w, acc->h, cur) : 0.0));
+	u->cost = p->cost_sample * (m2 - m1);
 	u->score = u->gain / u->cost;
 	return 1;
 }
 
 /* Count region r's pixels that its scale was planned for (ps) into its
  * chosen and gain, and set its cost. */
-static void region_count(const struct plan_params *p, struct plan_region *r, int w, int h,
+static void region_count(const struct plan_params *p, struct plan_region *r, int w,
 			 const unsigned char *ps, const double *gain)
 {
 	r->chosen = 0;
@@ -426,7 +415,7 @@ static void region_count(const struct plan_params *p, struct plan_region *r, int
 				r->gain += gain[i];
 			}
 		}
-	r->cost = rect_cost(p, r, w, h);
+	r->cost = rect_cost(p, r);
 }
 
 /*
@@ -463,8 +452,8 @@ static int split_regions(const struct plan_params *p, struct plan *out, const un
 			a.x1 = a.x0 + rw / 2 - 1;
 			b.x0 = a.x1 + 1;
 		}
-		region_count(p, &a, out->w, out->h, ps, gain);
-		region_count(p, &b, out->w, out->h, ps, gain);
+		region_count(p, &a, out->w, ps, gain);
+		region_count(p, &b, out->w, ps, gain);
 		void *q = realloc(out->regions, (out->nregions + 1) * sizeof(*out->regions));
 		if (!q)
 			return -1;
@@ -530,7 +519,7 @@ static int fit_budget(const struct plan_params *p, struct plan *out, const unsig
 			d->r = *r;
 			d->r.y0 = y;
 			d->r.y1 = y + p->tile - 1 < r->y1 ? y + p->tile - 1 : r->y1;
-			region_count(p, &d->r, out->w, out->h, ps, gain);
+			region_count(p, &d->r, out->w, ps, gain);
 			d->parent = k;
 			d->seq = (size_t)q;
 			d->keep = 0;
@@ -559,7 +548,7 @@ static int fit_budget(const struct plan_params *p, struct plan *out, const unsig
 			m->y1 = b[k].r.y1;
 			m->chosen += b[k].r.chosen;
 			m->gain += b[k].r.gain;
-			m->cost = rect_cost(p, m, out->w, out->h);
+			m->cost = rect_cost(p, m);
 		} else {
 			out->regions[n++] = b[k].r;
 		}
@@ -705,7 +694,7 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	size_t taken = 0;
 	for (; taken < nc && total0 > goal; taken++) {
 		const struct cand *c = &cand[taken];
-		double cs = p->cost_sample * scale_rays(p, w, h, c->s);
+		double cs = p->cost_sample * c->s * c->s;
 		if (spend0 + cs > cap)
 			break;
 		spend0 += cs;
