@@ -308,49 +308,85 @@ static double quad_twist(double q[4][3], const double mean[3])
  * its area (an edge, a texture, a penumbra's slope) their mean is far
  * closer than sigma^2 / nb, and the base pass's one sample at the centre
  * is the one that differs.  With vb, the new mean's own squared error
- * (quad_twist() smoothed), the old mean's is d2 - vb, and the merged
- * mean's (na^2 (d2 - vb) + nb^2 vb) / (na + nb)^2: the diff is that where
- * it is smaller.  Pixel i has folded; old is its mean before, mean the new
- * samples'.
+ * (quad_twist() averaged over the 3 x 3 pixels around that have one: one
+ * pixel's is one number's square, about a degree of freedom), the old
+ * mean's is d2 - vb, and the merged mean's (na^2 (d2 - vb) + nb^2 vb) /
+ * (na + nb)^2: the diff is that where it is smaller.
+ *
+ * A region's merge notes each pixel it folds (strat_note()), and once all
+ * have folded strat_end() lowers their diffs.  Without the memory
+ * (strat_begin() returns 0) the diffs stay the independent samples'.
  */
-static void strat_diff(struct image *acc, size_t i, const double old[3], double na,
-		       const double mean[3], double nb, double vb)
+struct strat {
+	int x0, y0, rw, rh;
+	double *tw;		/* the twist of the new samples, NaN where none */
+	double *d2, *na, *nb;	/* the fold's difference and counts; nb 0: no fold */
+};
+
+static int strat_begin(struct strat *st, int x0, int y0, int x1, int y1)
 {
-	float *o = acc->px + i * ACC_NCH;
-	if (!(na > 0.0) || !(nb > 0.0) || !isfinite(vb) || !isfinite(o[ACC_DIFF]))
+	st->x0 = x0;
+	st->y0 = y0;
+	st->rw = x1 - x0 + 1;
+	st->rh = y1 - y0 + 1;
+	const size_t rn = (size_t)st->rw * st->rh;
+	st->tw = malloc(4 * rn * sizeof(*st->tw));
+	if (!st->tw)
+		return 0;
+	st->d2 = st->tw + rn;
+	st->na = st->d2 + rn;
+	st->nb = st->na + rn;
+	for (size_t k = 0; k < rn; k++) {
+		st->tw[k] = NAN;
+		st->nb[k] = 0.0;
+	}
+	return 1;
+}
+
+/* Pixel (x, y) (index i) has folded nb new samples of mean `mean` and
+ * twist tw (NaN: none) onto na of mean old. */
+static void strat_note(struct strat *st, const struct image *acc, size_t i, int x, int y,
+		       const double old[3], double na, const double mean[3], double nb, double tw)
+{
+	if (!st->tw)
 		return;
+	const size_t k = (size_t)(y - st->y0) * st->rw + (x - st->x0);
 	double e2[3];
 	for (int c = 0; c < 3; c++)
 		e2[c] = (mean[c] - old[c]) * (mean[c] - old[c]);
-	double d2 = rel3(o, e2), nt = na + nb;
-	double va = d2 > vb ? d2 - vb : 0.0;
-	double st = (na * na * va + nb * nb * vb) / (nt * nt);
-	if (isfinite(st) && st < o[ACC_DIFF])
-		o[ACC_DIFF] = (float)st;
+	st->tw[k] = tw;
+	st->d2[k] = rel3(acc->px + i * ACC_NCH, e2);
+	st->na[k] = na;
+	st->nb[k] = nb;
 }
 
-/* The quad_twist() of a region's pixels (tw, rw x rh, NaN where none)
- * smoothed by the mean over the 3 x 3 pixels around each that have one
- * (one pixel's is one number's square: about a degree of freedom), into
- * out. */
-static void twist_smooth(const double *tw, int rw, int rh, double *out)
+static void strat_end(struct strat *st, struct image *acc)
 {
-	for (int y = 0; y < rh; y++)
-		for (int x = 0; x < rw; x++) {
+	if (!st->tw)
+		return;
+	for (int y = 0; y < st->rh; y++)
+		for (int x = 0; x < st->rw; x++) {
+			const size_t k = (size_t)y * st->rw + x;
+			float *o = acc->px + ((size_t)(st->y0 + y) * acc->w + st->x0 + x) * ACC_NCH;
+			const double na = st->na[k], nb = st->nb[k], d2 = st->d2[k];
+			if (!isfinite(st->tw[k]) || !(na > 0.0) || !(nb > 0.0) || !isfinite(o[ACC_DIFF]))
+				continue;
 			double sum = 0.0;
 			int n = 0;
 			for (int j = y - 1; j <= y + 1; j++)
-				for (int k = x - 1; k <= x + 1; k++) {
-					if (j < 0 || j >= rh || k < 0 || k >= rw)
-						continue;
-					double t = tw[(size_t)j * rw + k];
-					if (isfinite(t)) {
-						sum += t;
+				for (int l = x - 1; l <= x + 1; l++)
+					if (j >= 0 && j < st->rh && l >= 0 && l < st->rw &&
+					    isfinite(st->tw[(size_t)j * st->rw + l])) {
+						sum += st->tw[(size_t)j * st->rw + l];
 						n++;
 					}
-				}
-			out[(size_t)y * rw + x] = isfinite(tw[(size_t)y * rw + x]) && n ? sum / n : NAN;
+			const double vb = sum / n, nt = na + nb;
+			const double st_d = (na * na * (d2 > vb ? d2 - vb : 0.0) + nb * nb * vb) / (nt * nt);
+			if (isfinite(st_d) && st_d < o[ACC_DIFF])
+				o[ACC_DIFF] = (float)st_d;
 		}
+	free(st->tw);
+	st->tw = NULL;
 }
 
 /* Pixel (x, y) of a grid render: its sub-pixels' values (sub, nq of them
@@ -401,26 +437,9 @@ static int grid_pixel(const struct image *acc, const struct image *img, int oy, 
 static long merge_grid(struct image *acc, const struct image *img, int oy, const int ch[3],
 		       int s, int x0, int y0, int x1, int y1, int pass)
 {
-	const int rw = x1 - x0 + 1, rh = y1 - y0 + 1;
-	const size_t rn = (size_t)rw * rh;
+	struct strat st;
+	strat_begin(&st, x0, y0, x1, y1);
 	long count = 0;
-	/* the new means' own errors (strat_diff()); without the memory the
-	 * diff is the independent samples' */
-	double *tw = malloc(2 * rn * sizeof(*tw)), *sm = tw ? tw + rn : NULL;
-	if (tw) {
-		for (int y = y0; y <= y1; y++)
-			for (int x = x0; x <= x1; x++) {
-				double sub[4][3], mean[3], m2[3];
-				int g;
-				size_t k = (size_t)(y - y0) * rw + (x - x0);
-				tw[k] = NAN;
-				if (accum_has_scale(acc, (size_t)y * acc->w + x, s))
-					continue;
-				if (grid_pixel(acc, img, oy, ch, s, x, y, sub, mean, m2, &g) == 4)
-					tw[k] = quad_twist(sub, mean);
-			}
-		twist_smooth(tw, rw, rh, sm);
-	}
 	for (int y = y0; y <= y1; y++)
 		for (int x = x0; x <= x1; x++) {
 			size_t i = (size_t)y * acc->w + x;
@@ -431,11 +450,10 @@ static long merge_grid(struct image *acc, const struct image *img, int oy, const
 			if (accum_fold(acc, i, s, nq * g, mean, m2, pass) || !nq)
 				continue;
 			count++;
-			if (sm)
-				strat_diff(acc, i, old, na, mean, (double)nq * g,
-					   sm[(size_t)(y - y0) * rw + (x - x0)]);
+			strat_note(&st, acc, i, x, y, old, na, mean, (double)nq * g,
+				   nq == 4 ? quad_twist(sub, mean) : NAN);
 		}
-	free(tw);
+	strat_end(&st, acc);
 	return count;
 }
 
@@ -545,22 +563,10 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 			*folded = c;
 		return 0;
 	}
-	const int rw = x1 - x0 + 1, rh = y1 - y0 + 1;
-	const size_t rn = (size_t)rw * rh;
-	/* as merge_grid()'s: the quadrants of an even scale's s x s */
-	double *tw = s % 2 == 0 ? malloc(2 * rn * sizeof(*tw)) : NULL, *sm = tw ? tw + rn : NULL;
-	if (tw) {
-		for (int y = y0; y <= y1; y++)
-			for (int x = x0; x <= x1; x++) {
-				double mean[3], m2[3], q[4][3];
-				int n = scaled_pixel(img, oy, ch, s, x, y, mean, m2, q);
-				size_t k = (size_t)(y - y0) * rw + (x - x0);
-				tw[k] = n == s * s && !accum_has_scale(acc, (size_t)y * acc->w + x, s)
-						? quad_twist(q, mean)
-						: NAN;
-			}
-		twist_smooth(tw, rw, rh, sm);
-	}
+	/* as merge_grid()'s, with the quadrants of an even scale's s x s */
+	struct strat st = { 0 };
+	if (s % 2 == 0)
+		strat_begin(&st, x0, y0, x1, y1);
 	long count = 0;
 	for (int y = y0; y <= y1; y++) {
 		for (int x = x0; x <= x1; x++) {
@@ -572,12 +578,11 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 			if (accum_fold(acc, i, s, n, mean, m2, pass) || !n)
 				continue;
 			count++;
-			if (sm)
-				strat_diff(acc, i, old, na, mean, n,
-					   sm[(size_t)(y - y0) * rw + (x - x0)]);
+			strat_note(&st, acc, i, x, y, old, na, mean, n,
+				   n == s * s ? quad_twist(q, mean) : NAN);
 		}
 	}
-	free(tw);
+	strat_end(&st, acc);
 	if (folded)
 		*folded = count;
 	return 0;

@@ -156,7 +156,7 @@ int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
  * (spread between the sub-pixels can be an edge's, not noise).  The
  * fold's difference (the 'diff' channel) is lowered where the new samples'
  * quadrants agree (their mean is closer than independent samples' would
- * be: see strat_diff() in accum.c).  *folded counts the pixels that took
+ * be: see struct strat in accum.c).  *folded counts the pixels that took
  * new samples (may be NULL).  Fails on a size mismatch or rows not read.
  */
 int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,

@@ -109,13 +109,12 @@ static void *run_band(void *arg)
 					for (int o = 0; o <= 2 * f; o++)
 						d += hs[(size_t)(j + o) * w + x];
 					d /= area;
+					/* also a neighbour that is not finite: its term
+					 * at the patch's centre is infinite (term()) */
 					if (d >= 40.0)
 						continue;
 					const double wt = d > 0.0 ? exp(-d) : 1.0;
 					const size_t i = (size_t)j * w + x, q = (size_t)qy * w + qx;
-					if (!isfinite(b->rgb[3 * q]) || !isfinite(b->rgb[3 * q + 1]) ||
-					    !isfinite(b->rgb[3 * q + 2]))
-						continue;
 					for (int c = 0; c < 3; c++) {
 						num[3 * i + c] += wt * b->rgb[3 * q + c];
 						v2[3 * i + c] += wt * wt * b->var[3 * q + c];
