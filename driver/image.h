@@ -57,8 +57,9 @@ int image_read_exr_rows(const char *path, int y0, int y1, struct image *out, int
 int image_exr_size(const char *path, int *w, int *h, char *err, size_t errlen);
 
 /*
- * Write img as a single-part scanline EXR, 32-bit float, PIZ compression,
- * one channel per img channel with img's names (OpenEXR stores channels
+ * Write img as a single-part scanline EXR, 32-bit float, PIZ compression
+ * (ZIP at zlib's level 1 below 1024 pixels wide, where it is faster), one
+ * channel per img channel with img's names (OpenEXR stores channels
  * sorted by name, so image_read_exr() returns them in that order).  Names
  * must be distinct and non-empty.  The data is written to a temporary file
  * PATH.tmp.XXXXXX in the same directory and renamed over path only when

@@ -56,16 +56,16 @@ static double mean_var(const float *o)
  * it that have one (a single pixel's is a difference of two noisy means:
  * about three degrees of freedom); NaN when none has.  A neighbour counts
  * by how alike the two pixels' sample variances are (of their means,
- * relative; mv holds every pixel's mean_var()): with weight
+ * relative; lmv holds the logarithm of every pixel's mean_var()): with weight
  * exp(-ln^2(v_j / v_i) / 2), so a factor e apart 0.61, ten apart 0.07.  A
  * plain mean spread one pixel's difference over all 25: the horizon's (a
  * sky/floor edge whose coarse samples all fell on the floor) put 0.035 on
  * the flat sky rows beside it, a quarter of soft_shadows' whole estimate at
  * --target 3e-3, and the thin rods' onto the background around them.
  */
-static double diff_around(const struct image *acc, const double *mv, int x, int y)
+static double diff_around(const struct image *acc, const double *lmv, int x, int y)
 {
-	const double vi = mv[(size_t)y * acc->w + x];
+	const double li = lmv[(size_t)y * acc->w + x];
 	double sum = 0.0, wsum = 0.0;
 	for (int j = y - DIFF_RADIUS; j <= y + DIFF_RADIUS; j++) {
 		if (j < 0 || j >= acc->h)
@@ -77,7 +77,7 @@ static double diff_around(const struct image *acc, const double *mv, int x, int 
 			const float d = acc->px[q * ACC_NCH + ACC_DIFF];
 			if (!isfinite(d))
 				continue;
-			double l = log(mv[q] / vi), wt = exp(-0.5 * l * l);
+			double l = lmv[q] - li, wt = exp(-0.5 * l * l);
 			sum += wt * d;
 			wsum += wt;
 		}
@@ -95,8 +95,8 @@ int plan_pixel_errors(const struct image *acc, const float *press, const float *
 			      acc->w, acc->h);
 		return -1;
 	}
-	for (size_t i = 0; i < n; i++)
-		mv[i] = mean_var(acc->px + i * ACC_NCH);
+	for (size_t i = 0; i < n; i++)	/* ln of each, once: 25 neighbours use it */
+		mv[i] = log(mean_var(acc->px + i * ACC_NCH));
 	double sum = 0.0;
 	for (size_t i = 0; i < n; i++) {
 		const float *o = acc->px + i * ACC_NCH;

@@ -236,6 +236,8 @@ struct run {
 				 * until then) */
 	double write_s;		/* the last pass's writes of its work directory
 				 * and image, wall seconds (final_reserve()) */
+	double comp_s;		/* the image's one compressed write before the
+				 * end, wall seconds (0: none yet) */
 	double renders_end;	/* when the last pass's renders ended (now_s()) */
 	double tail_s;		/* from then to the end of its writes: merges,
 				 * analysis, writes (0: no region pass yet) */
@@ -565,13 +567,21 @@ out:
 	return rc;
 }
 
+/*
+ * OUT.exr: after each pass (so that it holds the best image so far,
+ * whatever happens next) uncompressed, since the next pass or the end
+ * rewrites it; the last one and the first (whose time final_reserve()
+ * takes for the last's) compressed (compress).  Uncompressed, the
+ * in-between writes at 160x120 took 0.0008 CPU s against PIZ's 0.0105.
+ */
 static int write_output(struct run *r, const struct lpr_result *res, int filter, double *est,
-			char *err, size_t errlen)
+			int compress, char *err, size_t errlen)
 {
 	struct image out = {0};
 	if (final_image(r, res, filter, est, &out, err, errlen))
 		return -1;
-	int rc = image_write_exr(r->out, &out, err, errlen);
+	int rc = compress ? image_write_exr(r->out, &out, err, errlen)
+		      : image_write_exr_raw(r->out, &out, err, errlen);
 	image_release(&out);
 	return rc;
 }
@@ -688,8 +698,9 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 	fprintf(f, "  ],\n  \"totals\": {\"passes\": %zu, \"wall_s\": %.3f, \"cpu_s\": %.3f, "
 		"\"driver_cpu_s\": %.3f, \"all_cpu_s\": %.3f, \"invocations\": %d, "
 		"\"failed\": %d, \"pixels\": %ld, \"samples\": %.0f, "
-		"\"samples_per_pixel\": %.4g, \"est_relmse\": %.6g}\n}\n",
-		r->npasses, tw, tc, td, tc + td, ti, tf, tp, ts, ts / ((double)r->w * r->h), est);
+		"\"samples_per_pixel\": %.4g, \"est_relmse\": %.6g, \"own_cpu_s\": %.3f}\n}\n",
+		r->npasses, tw, tc, td, tc + td, ti, tf, tp, ts, ts / ((double)r->w * r->h), est,
+		self_cpu());
 	return file_commit(f, tmp, r->report, err, errlen);
 }
 
@@ -1316,18 +1327,22 @@ static int one_step(const struct run *r, int *sparse)
  * (merging the renders, the analysis, the writes; before the first, the
  * base pass's analysis and writes), then the final stage: under --final
  * auto the filter (measured at 0.3 to 0.45 of an analysis: 0.14 s against
- * 0.28 to 0.45 s at 640x480 on two cores, 2026-11-23), the error map
- * beside the image (as long again as the pass's writes), and 0.1 s.  With
+ * 0.28 to 0.45 s at 640x480 on two cores, 2026-11-23), the image
+ * compressed (the passes write it uncompressed, but for the first, timed
+ * for this) and the error map beside it (MAP_SHARE as long: its 8
+ * channels took 1.18 to 1.19 times the image's time to write at 160x120
+ * and 640x480), and 0.1 s.  With
  * the analysis and 0.1 s alone, soft_shadows at 640x480 under --budget 4
  * ended at 4.2 s without the filter, 4.4 to 4.6 s with it (the final
  * stage 0.4 s, the merges 0.13 s).
  */
 #define FILTER_SHARE 0.5
+#define MAP_SHARE 1.2
 static double final_reserve(const struct run *r)
 {
 	const double a = r->passes[r->npasses - 1].analysis_s;
 	const double tail = r->tail_s > 0.0 ? r->tail_s : a + r->write_s;
-	return tail + (r->filter ? FILTER_SHARE * a : 0.0) + r->write_s + 0.1;
+	return tail + (r->filter ? FILTER_SHARE * a : 0.0) + (1.0 + MAP_SHARE) * r->comp_s + 0.1;
 }
 
 /*
@@ -1889,10 +1904,13 @@ bad:
 		last->analysis_s = now_s() - ta;
 		last->wall_s += last->analysis_s;
 		double tw = now_s();
+		const int timed = r.comp_s == 0.0;	/* compressed, once */
 		if (save_progress(&r, err, sizeof err) ||
-		    write_output(&r, &res, 0, NULL, err, sizeof err))
+		    write_output(&r, &res, 0, NULL, timed, err, sizeof err))
 			goto fail;
 		r.write_s = now_s() - tw;
+		if (timed)
+			r.comp_s = r.write_s > 1e-6 ? r.write_s : 1e-6;
 		if (r.renders_end > 0.0)
 			r.tail_s = now_s() - r.renders_end;
 		double el = elapsed(&r);
@@ -1917,7 +1935,7 @@ bad:
 			double e_int;
 			if (analyse(&r, &res, err, sizeof err) == 0 &&
 			    estimate(&r, &res, &e_int, err, sizeof err) == 0)
-				write_output(&r, &res, r.filter, NULL, err, sizeof err);
+				write_output(&r, &res, r.filter, NULL, 1, err, sizeof err);
 			goto interrupted;
 		}
 		if (rc < 0)
@@ -1936,7 +1954,7 @@ bad:
 	 * samples') */
 	r.took = accum_final_choose(&r.acc, res.fit, res.error, res.leverage, r.noise, r.final,
 				    r.take, r.est);
-	if (write_output(&r, &res, r.filter, r.est, err, sizeof err))
+	if (write_output(&r, &res, r.filter, r.est, 1, err, sizeof err))
 		goto fail;
 	double est = 0.0;
 	for (size_t k = 0; k < (size_t)r.w * r.h; k++)
