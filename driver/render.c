@@ -55,7 +55,7 @@ static const char usage[] =
 	"(PRESS) and re-render only the regions worth it at scales 2, 4, 8 and 16\n"
 	"(4, then about 16, 64 and 256 new samples per pixel), until the estimated\n"
 	"image relMSE reaches the target, the budget is spent, the passes run out, or\n"
-	"no pixel would gain.\n";
+	"no pixel would gain (under a budget: a pass would gain less than 1%).\n";
 
 /* (two strings: C11 promises no more than 4095 characters in one) */
 static const char usage_options[] =
@@ -1351,6 +1351,7 @@ static double final_reserve(const struct run *r)
  * -1 on failure, POV_INTERRUPTED when a signal came.
  */
 enum { PASS_STOP = 2 };
+#define MIN_PASS_GAIN 0.01
 static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 {
 	double t = now_s(), c = self_cpu();
@@ -1402,6 +1403,15 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			return -1;
 		if (pl.outcome != PLAN_REFINE) {
 			r->stop = plan_outcome_name(pl.outcome);
+			plan_release(&pl);
+			return PASS_STOP;
+		}
+		/* under a budget, a pass that leaves the target unmet and
+		 * would take less than MIN_PASS_GAIN of the error off is not
+		 * worth POV-Ray's wait (a budget's last seconds: ten pixels) */
+		if (r->budget > 0.0 && pl.est_after > r->target &&
+		    pl.est_relmse - pl.est_after < MIN_PASS_GAIN * pl.est_relmse) {
+			r->stop = "too little left to gain";
 			plan_release(&pl);
 			return PASS_STOP;
 		}
