@@ -32,6 +32,7 @@ const char *plan_outcome_name(enum plan_outcome o)
 	case PLAN_TARGET_MET: return "target met";
 	case PLAN_NO_GAIN: return "no pixel would gain";
 	case PLAN_NO_BUDGET: return "budget spent";
+	case PLAN_LITTLE_GAIN: return "too little left to gain";
 	}
 	return "?";
 }
@@ -829,6 +830,13 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	if (out->est_after < 0.0)
 		out->est_after = 0.0;
 	out->outcome = PLAN_REFINE;
+	if (p->budget > 0.0 && out->est_after > p->target * p->margin &&
+	    out->est_relmse - out->est_after < p->min_pass_gain * out->est_relmse) {
+		out->outcome = PLAN_LITTLE_GAIN;
+		free(out->regions);
+		out->regions = NULL;
+		out->nregions = 0;
+	}
 	ret = 0;
 out:
 	free(gain);

@@ -46,6 +46,9 @@ struct plan_params {
 				 * chosen pixels on to later scales until the
 				 * samples cost this much (seconds; default 0:
 				 * never).  For a pass that may be the last. */
+	double min_pass_gain;	/* with a budget, a plan that leaves the goal
+				 * unmet and takes less than this share off the
+				 * estimate is PLAN_LITTLE_GAIN (default 0) */
 	int min_split;		/* split the dearest regions in two, up to
 				 * 2 max_regions, until none costs more than the
 				 * pass over min_split (the cores that render
@@ -102,6 +105,7 @@ enum plan_outcome {
 	PLAN_TARGET_MET,	/* the estimate is at or below the target */
 	PLAN_NO_GAIN,		/* no pixel would gain from more samples */
 	PLAN_NO_BUDGET,		/* the budget cannot pay for one region */
+	PLAN_LITTLE_GAIN,	/* under min_pass_gain (plan_params) */
 };
 
 struct plan {

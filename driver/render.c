@@ -1399,19 +1399,14 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		}
 		pp.grid = choose ? PLAN_GRID_ONLY : run_grid(r);
 		pp.min_split = r->cores;
+		/* under a budget, a pass that leaves the target unmet and
+		 * would take less than 1% of the error off is not worth
+		 * POV-Ray's wait (a budget's last seconds: ten pixels) */
+		pp.min_pass_gain = MIN_PASS_GAIN;
 		if (plan_make_from(&r->acc, r->est, &pp, &pl, err, errlen))
 			return -1;
 		if (pl.outcome != PLAN_REFINE) {
 			r->stop = plan_outcome_name(pl.outcome);
-			plan_release(&pl);
-			return PASS_STOP;
-		}
-		/* under a budget, a pass that leaves the target unmet and
-		 * would take less than MIN_PASS_GAIN of the error off is not
-		 * worth POV-Ray's wait (a budget's last seconds: ten pixels) */
-		if (r->budget > 0.0 && pl.est_after > r->target &&
-		    pl.est_relmse - pl.est_after < MIN_PASS_GAIN * pl.est_relmse) {
-			r->stop = "too little left to gain";
 			plan_release(&pl);
 			return PASS_STOP;
 		}

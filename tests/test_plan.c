@@ -927,7 +927,8 @@ static struct plan_input *plan_setup(struct plan_params *p)
 	return in;
 }
 
-/* 6. plan_make: refine, target met, no budget, packing, no gain. */
+/* 6. plan_make: refine, target met, no budget, packing, too little gain,
+ * no gain. */
 static void test_plan_make(void **state)
 {
 	static const int two[2][4] = { { 2, 2, 4, 4 }, { 58, 40, 61, 43 } };
@@ -1004,6 +1005,34 @@ static void test_plan_make(void **state)
 	assert_int_equal(pl.nregions, 1);
 	check_regions(&pl, &p);
 	assert_int_equal(pl.chosen_pixels, 9 + 16);
+	plan_release(&pl);
+	plan_params_init(&p);
+	image_release(&in->acc);
+
+	/* under a budget, a pass taking less than min_pass_gain of the
+	 * estimate off (the goal unmet) is not worth running; without a
+	 * budget the share does not count */
+	plan_input(in, block, 1, 0.25f);
+	p.target = 1e-6;
+	p.cost_job = 0.0;
+	p.budget = 1.0;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	/* the block at scale 2: 4/5 of its error off */
+	double share = (pl.est_relmse - pl.est_after) / pl.est_relmse;
+	assert_close(share, 0.8, 1e-9, 0.0, "share");
+	plan_release(&pl);
+	p.min_pass_gain = share + 0.01;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_LITTLE_GAIN);
+	assert_int_equal(pl.nregions, 0);
+	assert_string_equal(plan_outcome_name(pl.outcome), "too little left to gain");
+	plan_release(&pl);
+	p.min_pass_gain = share - 0.01;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	plan_release(&pl);
+	p.min_pass_gain = 1.0;
+	p.budget = 0.0;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	assert_true(pl.nregions > 0);
 	plan_release(&pl);
 	plan_params_init(&p);
 	image_release(&in->acc);
