@@ -837,7 +837,8 @@ static int write_fd(int fd, const char *path, const struct image *img, exr_pixel
 		rv = exr_set_longname_support(ctx, 1);
 	if (rv == EXR_ERR_SUCCESS)
 		rv = exr_initialize_required_attr_simple(ctx, part, img->w, img->h, comp);
-	/* zlib's fastest level: ZIP's default (4) took 30% longer for 1% less */
+	/* zlib's fastest level: the default (4) took 15 to 37% longer for files
+	 * about 1% smaller (160x120 and 320x240 images and error maps) */
 	if (rv == EXR_ERR_SUCCESS && comp == EXR_COMPRESSION_ZIP)
 		rv = exr_set_zip_compression_level(ctx, part, 1);
 	/*
