@@ -775,6 +775,33 @@ pp_table() {
 	}' "$CSV" "$rep"
 }
 
+# own_share: a paragraph on povpress's own process's share of its runs' CPU
+# (the report's own_cpu_s over the run's CPU, POV-Ray included), per scene
+# over all its povpress runs.
+own_share() {
+	local name dir f own cpu line=
+	for name in "${names[@]}"; do
+		dir=$OUT/$name
+		own=0 cpu=0
+		for f in "$dir"/pp-*.json; do
+			[[ -f $f && -f ${f%.json}.time ]] || continue
+			read -r own cpu < <(awk -v o="$own" -v c="$cpu" '
+				FNR == NR && /"own_cpu_s"/ {
+					sub(/.*"own_cpu_s": */, ""); sub(/[^0-9.eE+-].*/, ""); a = $0 }
+				FNR != NR { n = split($0, t, " ") }
+				END { if (n >= 2) print o + a, c + t[1] + t[2]; else print o, c }' \
+				"$f" <(tail -n 1 "${f%.json}.time"))
+		done
+		line+=$(awk -v n="$name" -v o="$own" -v c="$cpu" \
+			'BEGIN { if (c > 0) printf "%s %.0f%%, ", n, 100 * o / c }')
+	done
+	[[ -n $line ]] || return 0
+	echo
+	echo "povpress's own process (its analyses, filter and writes; the report's"
+	echo "\`own_cpu_s\`) took this share of its runs' CPU, POV-Ray's included, over all"
+	echo "of a scene's runs: ${line%, }."
+}
+
 echo
 echo "povpress render against POV-Ray's lower envelope (ratio < 1: povpress has the lower relMSE):"
 PPT=$(pp_table)
@@ -807,6 +834,7 @@ echo "$PPT" | awk -F'|' '{ printf "%-18s %-14s cpu %6s  relMSE %-9s POV-Ray %-22
 	echo "| scene | run | CPU s | wall s | relMSE | POV-Ray at equal CPU | ratio | equal-error speed-up | est/true | less ref | capture20 / oracle / local |"
 	echo "|---|---|---|---|---|---|---|---|---|---|---|"
 	echo "$PPT"
+	own_share
 } >>"$SUM"
 
 {
