@@ -1970,9 +1970,9 @@ bad:
 	if (r.report && write_report(&r, est, err, sizeof err))
 		goto fail;
 	if (!r.quiet && (r.tty || r.verbose)) {
-		double cpu = 0.0;
+		double cpu = self_cpu();	/* povpress's own, and its POV-Ray runs' */
 		for (size_t k = 0; k < r.npasses; k++)
-			cpu += r.passes[k].cpu_s + r.passes[k].driver_cpu_s;
+			cpu += r.passes[k].cpu_s;
 		fprintf(stderr, "povpress render: %s after %zu passes: estimated relMSE %.3g, "
 			"%.1f s, %.1f CPU s; wrote %s", r.stop, r.npasses - 1, est, elapsed(&r), cpu,
 			r.out);

@@ -58,9 +58,13 @@ printf '  base pass (1 sample per pixel)   relMSE %-10s PSNR %s dB\n' \
 printf '  povpress render                  relMSE %-10s PSNR %s dB\n' \
 	"$(val "$final" relmse)" "$(val "$final" psnr)"
 printf '  its own estimate of that relMSE  %s\n' "$(jget "$OUT/render.json" est_relmse)"
+# the POV-Ray children's CPU and povpress's own process's (analyses and writes
+# included)
+pov_cpu=$(jget "$OUT/render.json" cpu_s)
+own_cpu=$(jget "$OUT/render.json" own_cpu_s)
 printf '  cost: %s CPU s (POV-Ray %s, povpress %s), %s s wall, %s samples per pixel\n' \
-	"$(jget "$OUT/render.json" all_cpu_s)" "$(jget "$OUT/render.json" cpu_s)" \
-	"$(jget "$OUT/render.json" driver_cpu_s)" "$(jget "$OUT/render.json" wall_s)" \
+	"$(awk -v a="$pov_cpu" -v b="$own_cpu" 'BEGIN { printf "%.3f", a + b }')" \
+	"$pov_cpu" "$own_cpu" "$(jget "$OUT/render.json" wall_s)" \
 	"$(jget "$OUT/render.json" samples_per_pixel)"
 
 oiiotool "$OUT/render.exr" --colorconvert linear sRGB -o "$OUT/render.png"
