@@ -5,7 +5,8 @@
 # at s*W x s*H with antialiasing off, box-average each s x s block); the
 # lower envelope of all its runs is the bar povpress must beat.
 #
-# usage: scripts/sweep.sh [--quick] [--size WxH] [--repeat N] [SCENE.pov ...]
+# usage: scripts/sweep.sh [--quick] [--size WxH] [--repeat N] [--pov-repeat N]
+#                         [SCENE.pov ...]
 #        make sweep [SWEEP_ARGS="--quick scenes/media.pov"]; make bench (quick)
 #
 # Default: every scenes/*.pov at 160x120.  Needs build/povpress and
@@ -36,6 +37,11 @@
 #             --quick), sweep.csv keeping the run whose ratio to POV-Ray's
 #             lower envelope at its CPU time is the median: its plans hang
 #             on measured timings, and one run's ratio swings 2-4x
+# Each POV-Ray setting runs once, or N times with --pov-repeat N (1 to 9),
+# sweep.csv keeping the run of median CPU: its image is the same every run,
+# but its CPU moved 10-20% between sweeps (soft_shadows' +AM2 +A0.01 +R4
+# 0.719 and 0.872 s), and where the envelope steps a povpress run's ratio
+# can jump 3-fold with it.
 # (--quick: thresholds 0.3, 0.03, 0.0, depths 2, 3, targets 3e-3 and 1e-3,
 # budget 3.)  Every POV-Ray run is one process,
 #   povray -D -GA +FE +WT1 +W.. +H.. +O.. +I<scene> +L<scene's dir> [options]
@@ -65,7 +71,7 @@
 set -euo pipefail
 
 usage() {
-	sed -n 's/^# \{0,1\}//; 8,9p' "$0"
+	sed -n 's/^# \{0,1\}//; 8,10p' "$0"
 }
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
@@ -77,6 +83,7 @@ OUT=$BUILD/sweep
 
 quick=0
 repeat=
+pov_repeat=1
 size=160x120
 scenes=()
 while (($#)); do
@@ -88,6 +95,12 @@ while (($#)); do
 		shift
 		;;
 	--repeat=*) repeat=${1#--repeat=} ;;
+	--pov-repeat)
+		[[ $# -ge 2 ]] || { echo "sweep: --pov-repeat needs a count" >&2; exit 2; }
+		pov_repeat=$2
+		shift
+		;;
+	--pov-repeat=*) pov_repeat=${1#--pov-repeat=} ;;
 	--size)
 		[[ $# -ge 2 ]] || { echo "sweep: --size needs WxH" >&2; exit 2; }
 		size=$2
@@ -116,6 +129,11 @@ else
 	echo "sweep: invalid --repeat '$repeat': expected a count from 1 to 9" >&2
 	exit 2
 fi
+if [[ ! $pov_repeat =~ ^[1-9]$ ]]; then
+	echo "sweep: invalid --pov-repeat '$pov_repeat': expected a count from 1 to 9" >&2
+	exit 2
+fi
+POV_REPEAT=$pov_repeat
 ((${#scenes[@]})) || scenes=("$ROOT"/scenes/*.pov)
 
 # Odd reference scales: their sample grids share no position with the grids
@@ -451,7 +469,7 @@ for i in "${!scenes[@]}"; do
 		k=$((k + 1))
 		s=1
 		[[ $method == scale ]] && s=$setting
-		reps=1
+		reps=$POV_REPEAT
 		[[ $method == povpress ]] && reps=$REPEAT
 		rows=()
 		for ((rep = 1; rep <= reps; rep++)); do
@@ -496,9 +514,13 @@ for i in "${!scenes[@]}"; do
 				"$k" "$total" "$name" "$method" "$setting" "$rn" "$cpu" "$wall" "$relmse" \
 				"$(elapsed)" >&2
 		done
-		if ((reps > 1)); then
+		if ((reps > 1)) && [[ $method == povpress ]]; then
 			median_row "$name" "${rows[@]}" >>"$CSV.tmp" || die "no median of '$name' $setting"
 			printf '%s\n' "${rows[@]}" >>"$RCSV.tmp"
+		elif ((reps > 1)); then
+			# the same image each run: the run of median CPU
+			printf '%s\n' "${rows[@]}" | sort -t, -k4,4g | sed -n "$(((reps + 1) / 2))p" \
+				>>"$CSV.tmp"
 		else
 			echo "${rows[0]}" >>"$CSV.tmp"
 		fi
@@ -636,6 +658,8 @@ mode=full
 	echo "$(nproc) CPUs ($(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)), at ${W}x$H."
 	echo
 	echo "Every run is one POV-Ray process with \`+WT1\`; CPU is its user + system seconds."
+	((POV_REPEAT == 1)) ||
+		echo "Each setting ran $POV_REPEAT times (the same image); the row keeps the run of median CPU."
 	echo "The reference is the scene at its default knobs by resolution scaling at"
 	echo "s = $REF_S ($((REF_S * REF_S)) samples per pixel, antialiasing off, box-averaged); ref$CHK_S is"
 	echo "the same at s = $CHK_S. Budgets are multiples of the no-AA run's CPU time; \"AA\" is"
