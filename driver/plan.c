@@ -90,26 +90,26 @@ int plan_pixel_errors(const struct image *acc, const float *press, const float *
 		      double *e, double *noise, double *est, char *err, size_t errlen)
 {
 	size_t n = (size_t)acc->w * acc->h;
-	double *mv = malloc((n ? n : 1) * sizeof(*mv));
-	if (!mv) {
+	double *lmv = malloc((n ? n : 1) * sizeof(*lmv));
+	if (!lmv) {
 		errbuf_printf(err, errlen, "out of memory estimating a %dx%d image's errors",
 			      acc->w, acc->h);
 		return -1;
 	}
 	for (size_t i = 0; i < n; i++)	/* ln of each, once: 25 neighbours use it */
-		mv[i] = log(mean_var(acc->px + i * ACC_NCH));
+		lmv[i] = log(mean_var(acc->px + i * ACC_NCH));
 	double sum = 0.0;
 	for (size_t i = 0; i < n; i++) {
 		const float *o = acc->px + i * ACC_NCH;
 		double diff = isfinite(o[ACC_DIFF]) ?
-			diff_around(acc, mv, (int)(i % (size_t)acc->w), (int)(i / (size_t)acc->w)) : NAN;
+			diff_around(acc, lmv, (int)(i % (size_t)acc->w), (int)(i / (size_t)acc->w)) : NAN;
 		double ns = accum_pixel_noise(acc, i, diff);
 		e[i] = accum_pixel_error(acc, i, press[i], fit + 3 * i, ns);
 		if (noise)
 			noise[i] = ns;
 		sum += e[i];
 	}
-	free(mv);
+	free(lmv);
 	*est = n ? sum / n : 0.0;
 	return 0;
 }

@@ -491,15 +491,20 @@ for i in "${!scenes[@]}"; do
 				tail -n 15 "$dir/$rtag.log" >&2
 				die "povray failed on '$sc' ($method $setting); log in $dir/$rtag.log"
 			fi
-			if ((s > 1)); then
-				"$BOXDOWN" "$render" "$s" "$img" || die "cannot box-average '$render'"
-				rm -f "$render"
-			fi
 			read -r u sy wall < <(tail -n 1 "$dir/$rtag.time")
 			cpu=$(awk -v u="$u" -v s="$sy" 'BEGIN { printf "%.3f", u + s }')
-			cmp=$("$POVPRESS" compare "$img" "${REF[$sc]}") || die "cannot compare '$img'"
-			relmse=$(sed -n 's/^relmse: //p' <<<"$cmp")
-			psnr=$(sed -n 's/^psnr: //p' <<<"$cmp")
+			if [[ $method != povpress ]] && ((rep > 1)); then
+				# POV-Ray's image is the first run's again: only the time counts
+				rm -f "$render"
+			else
+				if ((s > 1)); then
+					"$BOXDOWN" "$render" "$s" "$img" || die "cannot box-average '$render'"
+					rm -f "$render"
+				fi
+				cmp=$("$POVPRESS" compare "$img" "${REF[$sc]}") || die "cannot compare '$img'"
+				relmse=$(sed -n 's/^relmse: //p' <<<"$cmp")
+				psnr=$(sed -n 's/^psnr: //p' <<<"$cmp")
+			fi
 			fid=,,,
 			if [[ $method == povpress ]]; then
 				# the loop's own estimate, and how well its error map ranks pixels
@@ -803,18 +808,15 @@ pp_table() {
 # (the report's own_cpu_s over the run's CPU, POV-Ray included), per scene
 # over all its povpress runs.
 own_share() {
-	local name dir f own cpu line=
+	local name f u sy line=
 	for name in "${names[@]}"; do
-		dir=$OUT/$name
-		own=0 cpu=0
-		for f in "$dir"/pp-*.json; do
+		local own=0 cpu=0
+		for f in "$OUT/$name"/pp-*.json; do
 			[[ -f $f && -f ${f%.json}.time ]] || continue
-			read -r own cpu < <(awk -v o="$own" -v c="$cpu" '
-				FNR == NR && /"own_cpu_s"/ {
-					sub(/.*"own_cpu_s": */, ""); sub(/[^0-9.eE+-].*/, ""); a = $0 }
-				FNR != NR { n = split($0, t, " ") }
-				END { if (n >= 2) print o + a, c + t[1] + t[2]; else print o, c }' \
-				"$f" <(tail -n 1 "${f%.json}.time"))
+			read -r u sy _ < <(tail -n 1 "${f%.json}.time")
+			own=$(awk -v o="$own" -v a="$(grep -o '"own_cpu_s": [0-9.eE+-]*' "$f" | cut -d' ' -f2)" \
+				'BEGIN { print o + a }')
+			cpu=$(awk -v c="$cpu" -v u="$u" -v s="$sy" 'BEGIN { print c + u + s }')
 		done
 		line+=$(awk -v n="$name" -v o="$own" -v c="$cpu" \
 			'BEGIN { if (c > 0) printf "%s %.0f%%, ", n, 100 * o / c }')
