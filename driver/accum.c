@@ -343,10 +343,11 @@ static int strat_begin(struct strat *st, int x0, int y0, int x1, int y1)
 	return 1;
 }
 
-/* Pixel (x, y) (index i) has folded nb new samples of mean `mean` and
- * twist tw (NaN: none) onto na of mean old. */
+/* Pixel (x, y) (index i) has folded nb new samples of mean `mean`, with
+ * quadrant means q (NULL: not all four), onto na of mean old. */
 static void strat_note(struct strat *st, const struct image *acc, size_t i, int x, int y,
-		       const double old[3], double na, const double mean[3], double nb, double tw)
+		       const double old[3], double na, const double mean[3], double nb,
+		       double q[4][3])
 {
 	if (!st->tw)
 		return;
@@ -354,7 +355,7 @@ static void strat_note(struct strat *st, const struct image *acc, size_t i, int 
 	double e2[3];
 	for (int c = 0; c < 3; c++)
 		e2[c] = (mean[c] - old[c]) * (mean[c] - old[c]);
-	st->tw[k] = tw;
+	st->tw[k] = q ? quad_twist(q, mean) : NAN;
 	st->d2[k] = rel3(acc->px + i * ACC_NCH, e2);
 	st->na[k] = na;
 	st->nb[k] = nb;
@@ -451,7 +452,7 @@ static long merge_grid(struct image *acc, const struct image *img, int oy, const
 				continue;
 			count++;
 			strat_note(&st, acc, i, x, y, old, na, mean, (double)nq * g,
-				   nq == 4 ? quad_twist(sub, mean) : NAN);
+				   nq == 4 ? sub : NULL);
 		}
 	strat_end(&st, acc);
 	return count;
@@ -578,8 +579,7 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 			if (accum_fold(acc, i, s, n, mean, m2, pass) || !n)
 				continue;
 			count++;
-			strat_note(&st, acc, i, x, y, old, na, mean, n,
-				   n == s * s ? quad_twist(q, mean) : NAN);
+			strat_note(&st, acc, i, x, y, old, na, mean, n, n == s * s ? q : NULL);
 		}
 	}
 	strat_end(&st, acc);
