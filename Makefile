@@ -23,7 +23,7 @@ LIB_DRV_OBJ = $(filter-out $(BUILD)/driver/main.o,$(DRV_OBJ))
 
 UNIT_SRC = $(wildcard tests/test_*.c)
 UNIT_BIN = $(UNIT_SRC:tests/%.c=$(BUILD)/tests/%)
-TOOL_BIN = $(BUILD)/tests/gen_image $(BUILD)/bench/bench_analyze
+TOOL_BIN = $(BUILD)/tests/gen_image $(BUILD)/bench/bench_analyze $(BUILD)/bench/bench_denoise
 
 .PHONY: all check unit e2e bench clean deps demo sweep sampler
 .SECONDARY:
@@ -52,6 +52,11 @@ $(BUILD)/bench/bench_analyze: $(BUILD)/scripts/bench_analyze.o $(REG_OBJ) | $(BU
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
 
+$(BUILD)/bench/bench_denoise: $(BUILD)/scripts/bench_denoise.o $(BUILD)/driver/denoise.o \
+		$(BUILD)/driver/errbuf.o | $(BUILD)/.deps
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
+
 # A helper of the scripts and tests: box-average an EXR (see scripts/boxdown.c).
 $(BUILD)/tools/boxdown: $(BUILD)/scripts/boxdown.o $(BUILD)/driver/downsample.o \
 		$(BUILD)/driver/image.o $(BUILD)/driver/errbuf.o
@@ -69,12 +74,14 @@ e2e: $(BUILD)/povpress $(BUILD)/tests/gen_image $(BUILD)/tools/boxdown
 
 check: unit e2e
 
-# Analysis throughput, then povpress render against POV-Ray alone on the
+# Analysis and filter throughput, then povpress render against POV-Ray alone on the
 # bundled scenes in quick mode (BENCH_ARGS="scenes/media.pov" for one scene;
 # `make sweep` is the full benchmark).
 BENCH_ARGS ?=
-bench: $(BUILD)/bench/bench_analyze $(BUILD)/povpress $(BUILD)/tools/boxdown
+bench: $(BUILD)/bench/bench_analyze $(BUILD)/bench/bench_denoise $(BUILD)/povpress \
+		$(BUILD)/tools/boxdown
 	$(BUILD)/bench/bench_analyze
+	$(BUILD)/bench/bench_denoise
 	BUILD=$(BUILD) scripts/sweep.sh --quick $(BENCH_ARGS)
 
 demo: $(BUILD)/povpress $(BUILD)/tools/boxdown

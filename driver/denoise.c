@@ -24,6 +24,21 @@
 #define TERM_EPS 1e-6
 #define MAX_RADIUS 16
 
+/*
+ * The row loops in an AVX2 build too, chosen at load time, as the
+ * regression's fast path does (regression/fastpath.c); ISO C contracts no
+ * multiply-add, so both builds give the same values.  Without trapping math
+ * the compiler may evaluate both sides of a term's selects (a comparison
+ * with a NaN would raise an exception no one tests), which is what lets it
+ * vectorise them; no value changes.
+ */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define DENOISE_CLONES \
+	__attribute__((target_clones("arch=x86-64-v3", "default"), optimize("no-trapping-math")))
+#else
+#define DENOISE_CLONES
+#endif
+
 void denoise_params_init(struct denoise_params *p)
 {
 	p->radius = 3;
@@ -32,9 +47,21 @@ void denoise_params_init(struct denoise_params *p)
 	p->nthreads = 0;
 }
 
+/*
+ * The image in planes, shared by every band: each channel's values and
+ * variances, and which pixels have a value that is not finite (a hole no
+ * fit reached: no one's neighbour).  In planes the terms of a row are a
+ * loop the compiler vectorises.
+ */
+struct planes {
+	const float *y[3], *v[3];
+	const unsigned char *bad;
+};
+
 struct band {
 	int w, h, y0, y1;
 	const float *rgb, *var;
+	const struct planes *pl;
 	const struct denoise_params *p;
 	float *out, *vout, *self;
 	int failed;
@@ -45,89 +72,189 @@ static int clampi(int v, int lo, int hi)
 	return v < lo ? lo : v > hi ? hi : v;
 }
 
-/* The term of pixel (x, y) against (x + dx, y + dy), both clamped inside. */
-static double term(const struct band *b, int x, int y, int dx, int dy, double k2)
+/* One channel's part of a term, added to t: a of pixel p, q of its
+ * neighbour, va and vq their variances (double).  A macro, so that the
+ * vectorised row (term_row()) and the clamped pixels (term_at()) compute
+ * it alike with each one's own compiler options. */
+#define TERM_CH(t, a, q, va, vq, k2)                                                         \
+	do {                                                                                 \
+		const double d_ = (a) - (q), vm_ = (va) < (vq) ? (va) : (vq);                  \
+		const double s_ = (d_ * d_ - ((va) + vm_)) /                                 \
+				  (2.0 * (k2) * vm_ + TERM_EPS * ((a) * (a) + METRICS_RELMSE_EPS)); \
+		(t) += s_ > TERM_FLOOR ? s_ : TERM_FLOOR;                                    \
+	} while (0)
+
+/* The term of pixel i against pixel q (indices into the planes). */
+static inline double term_at(const struct planes *pl, size_t i, size_t q, double k2)
 {
-	const int qx = clampi(x + dx, 0, b->w - 1), qy = clampi(y + dy, 0, b->h - 1);
-	const float *a = b->rgb + 3 * ((size_t)y * b->w + x), *q = b->rgb + 3 * ((size_t)qy * b->w + qx);
-	const float *va = b->var + 3 * ((size_t)y * b->w + x), *vq = b->var + 3 * ((size_t)qy * b->w + qx);
+	if (pl->bad[i] | pl->bad[q])
+		return HUGE_VAL;
 	double t = 0.0;
-	/* a value that is not finite (a hole no fit reached) is no one's
-	 * neighbour */
 	for (int c = 0; c < 3; c++) {
-		double d = (double)a[c] - q[c], vm = va[c] < vq[c] ? va[c] : vq[c];
-		if (!isfinite(d))
-			return HUGE_VAL;
-		double s = (d * d - (va[c] + vm)) /
-			   (2.0 * k2 * vm + TERM_EPS * ((double)a[c] * a[c] + METRICS_RELMSE_EPS));
-		t += s > TERM_FLOOR ? s : TERM_FLOOR;
+		const double a = pl->y[c][i], b = pl->y[c][q], va = pl->v[c][i], vq = pl->v[c][q];
+		TERM_CH(t, a, b, va, vq, k2);
 	}
 	return t / 3.0;
 }
 
-static void *run_band(void *arg)
+/* The terms tr[x], x in [xa, xb), of the pixels from index i against those
+ * from index q, where no neighbour is clamped. */
+DENOISE_CLONES
+static void term_row(double *restrict tr, const struct planes *pl, size_t i, size_t q, int xa,
+		     int xb, double k2)
 {
-	struct band *b = arg;
-	const int w = b->w, f = b->p->patch, R = b->p->radius;
-	const int nb = b->y1 - b->y0, nr = nb + 2 * f;
-	const double k2 = b->p->k * b->p->k, area = (double)(2 * f + 1) * (2 * f + 1);
-	double *t = malloc(sizeof(double) * (size_t)nr * w);
-	double *hs = malloc(sizeof(double) * (size_t)nr * w);
-	double *num = calloc((size_t)nb * w * 3, sizeof(double));
-	double *v2 = calloc((size_t)nb * w * 3, sizeof(double));
-	double *den = calloc((size_t)nb * w, sizeof(double));
-	double *own = calloc((size_t)nb * w, sizeof(double));
-	if (!t || !hs || !num || !v2 || !den || !own) {
-		b->failed = 1;
-		goto out;
+	const float *restrict a0 = pl->y[0] + i, *restrict a1 = pl->y[1] + i, *restrict a2 = pl->y[2] + i;
+	const float *restrict q0 = pl->y[0] + q, *restrict q1 = pl->y[1] + q, *restrict q2 = pl->y[2] + q;
+	const float *restrict u0 = pl->v[0] + i, *restrict u1 = pl->v[1] + i, *restrict u2 = pl->v[2] + i;
+	const float *restrict r0 = pl->v[0] + q, *restrict r1 = pl->v[1] + q, *restrict r2 = pl->v[2] + q;
+	const unsigned char *restrict ba = pl->bad + i, *restrict bq = pl->bad + q;
+	for (int x = xa; x < xb; x++) {
+		double t = 0.0;
+		const double x0 = a0[x], y0 = q0[x], v0 = u0[x], w0 = r0[x];
+		const double x1 = a1[x], y1 = q1[x], v1 = u1[x], w1 = r1[x];
+		const double x2 = a2[x], y2 = q2[x], v2 = u2[x], w2 = r2[x];
+		TERM_CH(t, x0, y0, v0, w0, k2);
+		TERM_CH(t, x1, y1, v1, w1, k2);
+		TERM_CH(t, x2, y2, v2, w2, k2);
+		const double m = t / 3.0;	/* unconditional: a select vectorises */
+		tr[x] = (ba[x] | bq[x]) ? HUGE_VAL : m;
 	}
+}
+
+/* hs[x] = the sum of tr[x - f .. x + f] in that order, for x in [xa, xb)
+ * (no index clamped), and dst[x] += src[x] on [xa, xb). */
+DENOISE_CLONES
+static void box_row(double *restrict hs, const double *restrict tr, int f, int xa, int xb)
+{
+	for (int x = xa; x < xb; x++)
+		hs[x] = tr[x - f];
+	for (int o = -f + 1; o <= f; o++)
+		for (int x = xa; x < xb; x++)
+			hs[x] += tr[x + o];
+}
+
+DENOISE_CLONES
+static void add_row(double *restrict dst, const double *restrict src, int xa, int xb)
+{
+	for (int x = xa; x < xb; x++)
+		dst[x] += src[x];
+}
+
+/*
+ * The neighbours' weights wt[x], x in [xa, xb), of the pixels from index i
+ * (in the band's sums, planes np apart) on those from index q (in the
+ * image's planes) into the sums: num += wt Y, v2 += wt^2 V, den += wt.  A
+ * weight of 0 is no neighbour: its value, perhaps not finite, is not read
+ * into the sums.
+ */
+DENOISE_CLONES
+static void add_weighted(double *restrict num, double *restrict v2, double *restrict den,
+			 const struct planes *pl, const double *restrict wt, size_t i, size_t q,
+			 size_t np, int xa, int xb)
+{
+	for (int c = 0; c < 3; c++) {
+		double *restrict nc = num + np * c + i, *restrict vc = v2 + np * c + i;
+		const float *restrict yc = pl->y[c] + q, *restrict uc = pl->v[c] + q;
+		for (int x = xa; x < xb; x++) {
+			const double k = wt[x], yv = yc[x], vv = uc[x];
+			nc[x] += k > 0.0 ? k * yv : 0.0;
+			vc[x] += k > 0.0 ? k * k * vv : 0.0;
+		}
+	}
+	for (int x = xa; x < xb; x++)
+		den[i + x] += wt[x];
+}
+
+/* A band's buffers for a chunk of up to `rows` rows (filter_rows()). */
+struct scratch {
+	int rows;
+	double *t, *hs, *ds, *num, *v2, *den, *own;
+};
+
+/*
+ * Rows [y0, y1) of the band's image, at most s->rows of them: for each
+ * offset of the search window, the terms of the rows and `patch` rows
+ * beyond on both sides, their patch sums, and the weights they give added
+ * to the rows' sums; then the rows' means.  A chunk of rows keeps its sums
+ * in the core's cache across the offsets (a band's whole sums, 56 bytes a
+ * pixel, did not fit: the sums' memory traffic was a third of the filter's
+ * time at 640x480).
+ */
+static void filter_rows(const struct band *b, int y0, int y1, const struct scratch *sc)
+{
+	const struct planes *pl = b->pl;
+	const int w = b->w, f = b->p->patch, R = b->p->radius;
+	const int nb = y1 - y0, nr = nb + 2 * f;
+	const double k2 = b->p->k * b->p->k, area = (double)(2 * f + 1) * (2 * f + 1);
+	double *t = sc->t, *hs = sc->hs, *ds = sc->ds;
+	double *num = sc->num, *v2 = sc->v2, *den = sc->den, *own = sc->own;
+	const size_t np = (size_t)nb * w;
+	memset(num, 0, sizeof(double) * np * 3);
+	memset(v2, 0, sizeof(double) * np * 3);
+	memset(den, 0, sizeof(double) * np);
+	memset(own, 0, sizeof(double) * np);
 	for (int dy = -R; dy <= R; dy++)
 		for (int dx = -R; dx <= R; dx++) {
+			/* x in [xa, xb): the neighbour x + dx inside the row */
+			const int xa = dx < 0 ? -dx : 0, xb = dx > 0 ? w - dx : w;
 			for (int r = 0; r < nr; r++) {
-				const int y = clampi(b->y0 - f + r, 0, b->h - 1);
-				for (int x = 0; x < w; x++)
-					t[(size_t)r * w + x] = term(b, x, y, dx, dy, k2);
+				const int y = clampi(y0 - f + r, 0, b->h - 1);
+				const int qy = clampi(y + dy, 0, b->h - 1);
+				const size_t row = (size_t)y * w, qrow = (size_t)qy * w;
+				double *tr = t + (size_t)r * w;
+				if (xa < xb) {
+					for (int x = 0; x < xa; x++)
+						tr[x] = term_at(pl, row + x, qrow + clampi(x + dx, 0, w - 1), k2);
+					term_row(tr, pl, row, qrow + dx, xa, xb, k2);
+					for (int x = xb; x < w; x++)
+						tr[x] = term_at(pl, row + x, qrow + clampi(x + dx, 0, w - 1), k2);
+				} else {
+					for (int x = 0; x < w; x++)
+						tr[x] = term_at(pl, row + x, qrow + clampi(x + dx, 0, w - 1), k2);
+				}
 			}
+			/* the patch's horizontal sums: its columns beyond the
+			 * border are the border's */
+			const int ha = f < w ? f : w, hb = w - f > ha ? w - f : ha;
 			for (int r = 0; r < nr; r++) {
 				const double *tr = t + (size_t)r * w;
+				double *hr = hs + (size_t)r * w;
 				for (int x = 0; x < w; x++) {
+					if (x == ha) {
+						box_row(hr, tr, f, ha, hb);
+						x = hb;
+						if (x >= w)
+							break;
+					}
 					double s = 0.0;
 					for (int o = -f; o <= f; o++)
 						s += tr[clampi(x + o, 0, w - 1)];
-					hs[(size_t)r * w + x] = s;
+					hr[x] = s;
 				}
 			}
 			for (int j = 0; j < nb; j++) {
-				const int y = b->y0 + j, qy = y + dy;
-				if (qy < 0 || qy >= b->h)
+				const int y = y0 + j, qy = y + dy;
+				if (qy < 0 || qy >= b->h || xa >= xb)
 					continue;
-				for (int x = 0; x < w; x++) {
-					const int qx = x + dx;
-					if (qx < 0 || qx >= w)
-						continue;
-					double d = 0.0;
-					for (int o = 0; o <= 2 * f; o++)
-						d += hs[(size_t)(j + o) * w + x];
-					d /= area;
-					/* also a neighbour that is not finite: its term
-					 * at the patch's centre is infinite (term()) */
-					if (d >= 40.0)
-						continue;
-					const double wt = d > 0.0 ? exp(-d) : 1.0;
-					const size_t i = (size_t)j * w + x, q = (size_t)qy * w + qx;
-					for (int c = 0; c < 3; c++) {
-						num[3 * i + c] += wt * b->rgb[3 * q + c];
-						v2[3 * i + c] += wt * wt * b->var[3 * q + c];
-					}
-					den[i] += wt;
-					if (!dx && !dy)
-						own[i] = wt;
+				memcpy(ds + xa, hs + (size_t)j * w + xa, sizeof(double) * (size_t)(xb - xa));
+				for (int o = 1; o <= 2 * f; o++)
+					add_row(ds, hs + (size_t)(j + o) * w, xa, xb);
+				for (int x = xa; x < xb; x++) {
+					const double d = ds[x] / area;
+					/* 0: no neighbour, also one that is not finite
+					 * (its term at the patch's centre is infinite,
+					 * term_at()) */
+					ds[x] = d >= 40.0 ? 0.0 : d > 0.0 ? exp(-d) : 1.0;
 				}
+				const size_t i = (size_t)j * w, q = (size_t)qy * w + dx;
+				add_weighted(num, v2, den, pl, ds, i, q, np, xa, xb);
+				if (!dx && !dy)
+					memcpy(own + i + xa, ds + xa, sizeof(double) * (size_t)(xb - xa));
 			}
 		}
 	for (int j = 0; j < nb; j++)
 		for (int x = 0; x < w; x++) {
-			const size_t i = (size_t)j * w + x, g = (size_t)(b->y0 + j) * w + x;
+			const size_t i = (size_t)j * w + x, g = (size_t)(y0 + j) * w + x;
 			/* the pixel's own weight is 1 (its distance to itself is
 			 * at most 0), so den >= 1, unless its value is not
 			 * finite: then it stays as it is */
@@ -142,20 +269,43 @@ static void *run_band(void *arg)
 				continue;
 			}
 			for (int c = 0; c < 3; c++) {
-				b->out[3 * g + c] = (float)(num[3 * i + c] / den[i]);
+				b->out[3 * g + c] = (float)(num[np * c + i] / den[i]);
 				if (b->vout)
-					b->vout[3 * g + c] = (float)(v2[3 * i + c] / (den[i] * den[i]));
+					b->vout[3 * g + c] = (float)(v2[np * c + i] / (den[i] * den[i]));
 			}
 			if (b->self)
 				b->self[g] = (float)(own[i] / den[i]);
 		}
-out:
-	free(t);
-	free(hs);
-	free(num);
-	free(v2);
-	free(den);
-	free(own);
+}
+
+/* Sums of about this many bytes fit a core's cache (56 bytes a pixel). */
+#define CHUNK_BYTES (512 * 1024)
+
+static void *run_band(void *arg)
+{
+	struct band *b = arg;
+	const int w = b->w, f = b->p->patch, nb = b->y1 - b->y0;
+	int rows = (int)(CHUNK_BYTES / (56 * (size_t)w));
+	rows = rows < 8 ? 8 : rows;
+	rows = rows > nb ? nb : rows;
+	const size_t nr = (size_t)rows + 2 * f, np = (size_t)rows * w;
+	struct scratch sc = { rows,
+			      malloc(sizeof(double) * nr * w), malloc(sizeof(double) * nr * w),
+			      malloc(sizeof(double) * (size_t)w), malloc(sizeof(double) * np * 3),
+			      malloc(sizeof(double) * np * 3), malloc(sizeof(double) * np),
+			      malloc(sizeof(double) * np) };
+	if (!sc.t || !sc.hs || !sc.ds || !sc.num || !sc.v2 || !sc.den || !sc.own)
+		b->failed = 1;
+	else
+		for (int y = b->y0; y < b->y1; y += rows)
+			filter_rows(b, y, y + rows < b->y1 ? y + rows : b->y1, &sc);
+	free(sc.t);
+	free(sc.hs);
+	free(sc.ds);
+	free(sc.num);
+	free(sc.v2);
+	free(sc.den);
+	free(sc.own);
 	return NULL;
 }
 
@@ -190,9 +340,33 @@ int denoise_nlm(int w, int h, const float *rgb, const float *var,
 		errbuf_printf(err, errlen, "out of memory filtering a %dx%d image", w, h);
 		return -1;
 	}
+	const size_t npx = (size_t)w * h;
+	float *pv = malloc(sizeof(float) * npx * 6);
+	unsigned char *bad = malloc(npx);
+	if (!pv || !bad) {
+		free(pv);
+		free(bad);
+		free(bs);
+		free(tid);
+		errbuf_printf(err, errlen, "out of memory filtering a %dx%d image", w, h);
+		return -1;
+	}
+	struct planes pl;
+	for (int c = 0; c < 3; c++) {
+		float *yc = pv + npx * c, *vc = pv + npx * (3 + c);
+		for (size_t i = 0; i < npx; i++) {
+			yc[i] = rgb[3 * i + c];
+			vc[i] = var[3 * i + c];
+		}
+		pl.y[c] = yc;
+		pl.v[c] = vc;
+	}
+	for (size_t i = 0; i < npx; i++)
+		bad[i] = !(isfinite(rgb[3 * i]) && isfinite(rgb[3 * i + 1]) && isfinite(rgb[3 * i + 2]));
+	pl.bad = bad;
 	for (int k = 0; k < nth; k++) {
 		bs[k] = (struct band){ w, h, (int)((long)h * k / nth), (int)((long)h * (k + 1) / nth),
-				       rgb, var, p, out, vout, self, 0 };
+				       rgb, var, &pl, p, out, vout, self, 0 };
 	}
 	for (int k = 1; k < nth; k++) {
 		if (pthread_create(&tid[k], NULL, run_band, &bs[k]))
@@ -207,6 +381,8 @@ int denoise_nlm(int w, int h, const float *rgb, const float *var,
 		pthread_join(tid[k], NULL);
 	for (int k = 0; k < nth; k++)
 		failed |= bs[k].failed;
+	free(pv);
+	free(bad);
 	free(bs);
 	free(tid);
 	if (failed) {

@@ -215,6 +215,115 @@ static void test_threads_same(void **state)
 	assert_memory_equal(a.self, b.self, sizeof a.self);
 }
 
+/*
+ * The filter's definition, pixel by pixel (denoise.h): for each pixel and
+ * each neighbour inside the image within the radius, the mean over the
+ * patch's offsets (each pixel clamped inside) of the term, the weight, and
+ * the weighted means.  Slow and plain, to check the row-wise, vectorised
+ * and chunked filter against.
+ */
+static double ref_term(int w, int h, const float *y, const float *v, int px, int py, int qx,
+		       int qy, double k)
+{
+	px = px < 0 ? 0 : px >= w ? w - 1 : px;
+	py = py < 0 ? 0 : py >= h ? h - 1 : py;
+	qx = qx < 0 ? 0 : qx >= w ? w - 1 : qx;
+	qy = qy < 0 ? 0 : qy >= h ? h - 1 : qy;
+	size_t a = 3 * ((size_t)py * w + px), b = 3 * ((size_t)qy * w + qx);
+	double t = 0.0;
+	for (int c = 0; c < 3; c++) {
+		double d = (double)y[a + c] - y[b + c];
+		if (!isfinite(d))
+			return HUGE_VAL;
+		double vm = v[a + c] < v[b + c] ? v[a + c] : v[b + c];
+		double e = (d * d - (v[a + c] + vm)) /
+			   (2.0 * k * k * vm + 1e-6 * ((double)y[a + c] * y[a + c] + 0.01));
+		t += e > -1.0 ? e : -1.0;
+	}
+	return t / 3.0;
+}
+
+static void ref_filter(int w, int h, const float *y, const float *v, int radius, int patch,
+		       double k, float *out, float *vout)
+{
+	for (int py = 0; py < h; py++)
+		for (int px = 0; px < w; px++) {
+			double num[3] = { 0 }, v2[3] = { 0 }, den = 0.0;
+			for (int dy = -radius; dy <= radius; dy++)
+				for (int dx = -radius; dx <= radius; dx++) {
+					int qx = px + dx, qy = py + dy;
+					if (qx < 0 || qx >= w || qy < 0 || qy >= h)
+						continue;
+					double d = 0.0;
+					for (int oy = -patch; oy <= patch; oy++)
+						for (int ox = -patch; ox <= patch; ox++) {
+							int ax = px + ox, ay = py + oy;
+							ax = ax < 0 ? 0 : ax >= w ? w - 1 : ax;
+							ay = ay < 0 ? 0 : ay >= h ? h - 1 : ay;
+							d += ref_term(w, h, y, v, ax, ay, ax + dx, ay + dy, k);
+						}
+					d /= (2.0 * patch + 1) * (2.0 * patch + 1);
+					if (d >= 40.0)
+						continue;
+					double wt = d > 0.0 ? exp(-d) : 1.0;
+					size_t q = 3 * ((size_t)qy * w + qx);
+					for (int c = 0; c < 3; c++) {
+						num[c] += wt * y[q + c];
+						v2[c] += wt * wt * v[q + c];
+					}
+					den += wt;
+				}
+			size_t i = 3 * ((size_t)py * w + px);
+			for (int c = 0; c < 3; c++) {
+				out[i + c] = den > 0.0 ? (float)(num[c] / den) : y[i + c];
+				vout[i + c] = den > 0.0 ? (float)(v2[c] / (den * den)) : v[i + c];
+			}
+		}
+}
+
+/* The filter against its definition on noisy texture with holes, noise
+ * that varies from pixel to pixel and noise-free pixels, at sizes where the
+ * window and the patch reach past both borders, and on images narrower
+ * than the patch or the window. */
+static void test_matches_definition(void **state)
+{
+	(void)state;
+	static const int sizes[][2] = { { 48, 40 }, { 37, 19 }, { 5, 33 }, { 3, 3 }, { 1, 7 } };
+	static const int params[][2] = { { 3, 2 }, { 1, 0 }, { 5, 3 } };
+	static float y[NPX * 3], v[NPX * 3], out[NPX * 3], vout[NPX * 3], ro[NPX * 3],
+		rv[NPX * 3], self[NPX];
+	for (size_t si = 0; si < sizeof sizes / sizeof sizes[0]; si++)
+		for (size_t pi = 0; pi < sizeof params / sizeof params[0]; pi++) {
+			const int w = sizes[si][0], h = sizes[si][1];
+			rng = 88172645463325252ull + si;
+			for (int i = 0; i < w * h * 3; i++) {
+				int x = (i / 3) % w, yy = (i / 3) / w;
+				double sd = uniform() < 0.1 ? 0.0 : 0.02 + 0.1 * uniform();
+				y[i] = (float)(0.3 + 0.4 * ((x / 4 + yy / 3) % 2) + sd * normal());
+				v[i] = (float)(sd * sd);
+			}
+			if (w * h > 20)
+				for (int c = 0; c < 3; c++)
+					y[3 * (w * h / 2) + c] = NAN;
+			struct denoise_params p;
+			char err[256];
+			denoise_params_init(&p);
+			p.radius = params[pi][0];
+			p.patch = params[pi][1];
+			p.nthreads = 2;
+			assert_int_equal(denoise_nlm(w, h, y, v, &p, out, vout, self, err, sizeof err), 0);
+			ref_filter(w, h, y, v, p.radius, p.patch, p.k, ro, rv);
+			for (int i = 0; i < w * h * 3; i++) {
+				if (isnan(ro[i])) {
+					assert_true(isnan(out[i]));
+					continue;
+				}
+				assert_true(fabs(out[i] - ro[i]) <= 1e-5 * (fabs(ro[i]) + 1e-3));
+				assert_true(fabs(vout[i] - rv[i]) <= 1e-5 * (fabs(rv[i]) + 1e-9));
+			}
+		}
+}
+
 static void test_bad_input(void **state)
 {
 	(void)state;
@@ -242,6 +351,7 @@ int main(void)
 		cmocka_unit_test(test_noise_free_unchanged),
 		cmocka_unit_test(test_hole_not_spread),
 		cmocka_unit_test(test_threads_same),
+		cmocka_unit_test(test_matches_definition),
 		cmocka_unit_test(test_bad_input),
 	};
 	return cmocka_run_group_tests(tests, NULL, NULL);
