@@ -10,6 +10,7 @@
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -86,8 +87,61 @@ static double diff_around(const struct image *acc, const double *lmv, int x, int
 	return wsum > 0.0 ? sum / wsum : NAN;
 }
 
-int plan_pixel_errors(const struct image *acc, const float *press, const float *fit,
-		      double *e, double *noise, double *est, char *err, size_t errlen)
+/* Rows [y0, y1) of plan_pixel_errors(), on a thread of their own. */
+struct err_band {
+	const struct image *acc;
+	const float *press, *fit;
+	double *e, *noise;
+	const double *lmv;
+	int y0, y1;
+	int stage;	/* 0: lmv of the rows, 1: their errors */
+	double *lmv_out;
+};
+
+static void *err_band_run(void *arg)
+{
+	const struct err_band *b = arg;
+	const struct image *acc = b->acc;
+	const size_t i0 = (size_t)b->y0 * acc->w, i1 = (size_t)b->y1 * acc->w;
+	if (b->stage == 0) {
+		for (size_t i = i0; i < i1; i++)	/* ln of each, once: 25 neighbours use it */
+			b->lmv_out[i] = log(mean_var(acc->px + i * ACC_NCH));
+		return NULL;
+	}
+	for (size_t i = i0; i < i1; i++) {
+		const float *o = acc->px + i * ACC_NCH;
+		double diff = isfinite(o[ACC_DIFF]) ?
+			diff_around(acc, b->lmv, (int)(i % (size_t)acc->w), (int)(i / (size_t)acc->w)) : NAN;
+		double ns = accum_pixel_noise(acc, i, diff);
+		b->e[i] = accum_pixel_error(acc, i, b->press[i], b->fit + 3 * i, ns);
+		if (b->noise)
+			b->noise[i] = ns;
+	}
+	return NULL;
+}
+
+/* Run stage of the bands, one thread each but the first (here); a band
+ * whose thread does not start runs here too. */
+static void err_bands_run(struct err_band *bs, int n, int stage)
+{
+	pthread_t tid[PLAN_MAX_THREADS];
+	int started[PLAN_MAX_THREADS] = { 0 };
+	for (int k = 0; k < n; k++)
+		bs[k].stage = stage;
+	for (int k = 1; k < n; k++)
+		started[k] = pthread_create(&tid[k], NULL, err_band_run, &bs[k]) == 0;
+	err_band_run(&bs[0]);
+	for (int k = 1; k < n; k++) {
+		if (started[k])
+			pthread_join(tid[k], NULL);
+		else
+			err_band_run(&bs[k]);
+	}
+}
+
+int plan_pixel_errors_threads(const struct image *acc, const float *press, const float *fit,
+			      double *e, double *noise, double *est, int nthreads, char *err,
+			      size_t errlen)
 {
 	size_t n = (size_t)acc->w * acc->h;
 	double *lmv = malloc((n ? n : 1) * sizeof(*lmv));
@@ -96,22 +150,31 @@ int plan_pixel_errors(const struct image *acc, const float *press, const float *
 			      acc->w, acc->h);
 		return -1;
 	}
-	for (size_t i = 0; i < n; i++)	/* ln of each, once: 25 neighbours use it */
-		lmv[i] = log(mean_var(acc->px + i * ACC_NCH));
-	double sum = 0.0;
-	for (size_t i = 0; i < n; i++) {
-		const float *o = acc->px + i * ACC_NCH;
-		double diff = isfinite(o[ACC_DIFF]) ?
-			diff_around(acc, lmv, (int)(i % (size_t)acc->w), (int)(i / (size_t)acc->w)) : NAN;
-		double ns = accum_pixel_noise(acc, i, diff);
-		e[i] = accum_pixel_error(acc, i, press[i], fit + 3 * i, ns);
-		if (noise)
-			noise[i] = ns;
-		sum += e[i];
-	}
+	/* bands of 64 rows or more: a thread's start costs more than a few
+	 * rows' errors */
+	int nb = nthreads < 1 ? 1 : nthreads > PLAN_MAX_THREADS ? PLAN_MAX_THREADS : nthreads;
+	if (nb > acc->h / 64)
+		nb = acc->h / 64 > 1 ? acc->h / 64 : 1;
+	struct err_band bs[PLAN_MAX_THREADS];
+	for (int k = 0; k < nb; k++)
+		bs[k] = (struct err_band){ acc, press, fit, e, noise, lmv,
+					   (int)((long)acc->h * k / nb), (int)((long)acc->h * (k + 1) / nb),
+					   0, lmv };
+	err_bands_run(bs, nb, 0);
+	err_bands_run(bs, nb, 1);
 	free(lmv);
+	/* summed in pixel order, whatever the threads: the same estimate */
+	double sum = 0.0;
+	for (size_t i = 0; i < n; i++)
+		sum += e[i];
 	*est = n ? sum / n : 0.0;
 	return 0;
+}
+
+int plan_pixel_errors(const struct image *acc, const float *press, const float *fit,
+		      double *e, double *noise, double *est, char *err, size_t errlen)
+{
+	return plan_pixel_errors_threads(acc, press, fit, e, noise, est, 1, err, errlen);
 }
 
 struct cand {

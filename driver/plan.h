@@ -136,6 +136,13 @@ const char *plan_outcome_name(enum plan_outcome o);
 int plan_pixel_errors(const struct image *acc, const float *press, const float *fit,
 		      double *e, double *noise, double *est, char *err, size_t errlen);
 
+/* The same on up to nthreads threads (at most PLAN_MAX_THREADS, bands of 64
+ * rows or more): the same values, the estimate summed in pixel order. */
+#define PLAN_MAX_THREADS 64
+int plan_pixel_errors_threads(const struct image *acc, const float *press, const float *fit,
+			      double *e, double *noise, double *est, int nthreads, char *err,
+			      size_t errlen);
+
 /* Plan one pass from the pixels' estimated errors e (plan_pixel_errors()). */
 int plan_make_from(const struct image *acc, const double *e, const struct plan_params *p,
 		   struct plan *out, char *err, size_t errlen);

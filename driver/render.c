@@ -469,7 +469,8 @@ static int stats_printed(void *arg, size_t index, const char *log)
 static int estimate(struct run *r, const struct lpr_result *res, double *est, char *err,
 		    size_t errlen)
 {
-	if (plan_pixel_errors(&r->acc, res->error, res->fit, r->est, r->noise, est, err, errlen))
+	if (plan_pixel_errors_threads(&r->acc, res->error, res->fit, r->est, r->noise, est, r->cores,
+				      err, errlen))
 		return -1;
 	r->took = accum_final_choose(&r->acc, res->fit, res->error, res->leverage, r->noise,
 				     r->final, r->take, NULL);

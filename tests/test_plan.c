@@ -1173,6 +1173,44 @@ static void set_px(struct image *acc, int x, int y, float n, float var, float di
 	o[ACC_DIFF] = diff;
 }
 
+/* Pixel errors on threads: the same values and estimate as on one, on an
+ * image of mixed pixels (1 to 20 samples, varied spread and differences,
+ * a hole), tall enough for several bands. */
+static double mixed_value(int x, int y, int c)
+{
+	return 0.1 + 0.6 * ((x / 5 + y / 7) % 2) + 0.05 * c + 0.002 * x;
+}
+
+static void test_pixel_errors_threads(void **state)
+{
+	enum { W = 37, H = 300, N = W * H };
+	struct image acc;
+	static float press[N], fit[3 * N];
+	static double e1[N], e4[N], n1[N], n4[N];
+	char err[256];
+
+	(void)state;
+	make_acc(&acc, W, H, mixed_value);
+	for (int i = 0; i < N; i++) {
+		int x = i % W, y = i / W;
+		float n = (float)(1 + (x * 3 + y * 5) % 20);
+		set_px(&acc, x, y, n, n > 1 ? 1e-4f * (float)(1 + (x * y) % 9) : 0.0f,
+		       n >= 4 ? 2e-5f * (float)(1 + (x + 2 * y) % 5) : NAN);
+		press[i] = 1e-4f * (float)(1 + (x + y) % 7);
+		for (int c = 0; c < 3; c++)
+			fit[3 * i + c] = (float)mixed_value(x, y, c) + 0.01f;
+	}
+	press[5 * W + 5] = NAN;
+	double est1, est4;
+	assert_int_equal(plan_pixel_errors(&acc, press, fit, e1, n1, &est1, err, sizeof err), 0);
+	assert_int_equal(plan_pixel_errors_threads(&acc, press, fit, e4, n4, &est4, 4, err,
+						   sizeof err), 0);
+	assert_memory_equal(e1, e4, sizeof e1);
+	assert_memory_equal(n1, n4, sizeof n1);
+	assert_true(est1 == est4 && est1 > 0.0);
+	image_release(&acc);
+}
+
 /* 6b. A pixel's error estimate: fold differences averaged over neighbours
  * of like sample variance, relative to an estimate of the true value. */
 /* The hidden-edge term of a pixel of value v whose neighbour differs by d
@@ -1702,6 +1740,7 @@ int main(void)
 		cmocka_unit_test(test_plan_make),
 		cmocka_unit_test(test_plan_budget),
 		cmocka_unit_test(test_pixel_errors),
+		cmocka_unit_test(test_pixel_errors_threads),
 		cmocka_unit_test(test_final_choice),
 		cmocka_unit_test(test_sparse_error),
 		cmocka_unit_test(test_regions_file),
