@@ -540,6 +540,28 @@ SCENE
 check "a scene needing the user's +HI header renders under a budget" test $? -eq 0
 check "... and no early render took the header's place" \
 	test "$(grep -o '"prelaunched": [1-9]' "$T/hi/r.json" | wc -l)" -eq 0
+# a radiosity scene under a budget: its radiosity pass is started with the
+# base pass and taken from its gate; with --prelaunch off it starts afresh
+for m in auto off; do
+	"$PP" render "$SC/radiosity_room.pov" -o "$T/rp-$m.exr" -W 80 -H 60 --budget 4 \
+		--target 1e-6 --max-passes 0 --prelaunch $m --workdir "$T/rp $m" --keep-workdir \
+		--report "$T/rp-$m.json" -v 2>"$T/rp-$m.log"
+	eval "rprc_$m=$?"
+done
+check "radiosity under a budget, --prelaunch auto: the run succeeds" test "$rprc_auto" -eq 0
+check "... its radiosity pass was started early" \
+	grep -q "the radiosity pass was started early" "$T/rp-auto.log"
+check "... the base pass's record counts it" \
+	grep -q '"pass": 0,.*"prelaunched": 1' "$T/rp-auto.json"
+check "... no gate left in the work directory" test -z "$(find "$T/rp auto" -name 'gate-*')"
+check "... no POV-Ray child left" no_povray_left "$T/rp auto"
+check "... the output is a complete image" valid_exr "$T/rp-auto.exr"
+check "... its radiosity pass ran at scale 4" grep -q '"radiosity_scale": 4' "$T/rp-auto.json"
+check "radiosity under a budget, --prelaunch off: the run succeeds" test "$rprc_off" -eq 0
+check "... and no render was started early" \
+	test "$(grep -o '"prelaunched": [1-9]' "$T/rp-off.json" | wc -l)" -eq 0
+check "... the same image either way (one thread, the same solution)" \
+	test "$("$PP" compare "$T/rp-auto.exr" "$T/rp-off.exr" | sed -n 's/^relmse: //p')" = 0
 # interrupted while the early renders wait at their gates
 "$PP" render "$SC/focal_blur.pov" -o "$T/pl-int.exr" -W $W -H $H --budget 5 --target 1e-6 \
 	-q --workdir "$T/pl int" &
