@@ -10,6 +10,7 @@
  * (a 480x270 crop, every pixel forced through the general path).
  */
 #include "regression/lpr.h"
+#include "scripts/bench.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -17,40 +18,13 @@
 #include <string.h>
 #include <time.h>
 
-static double now(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 static unsigned long long rng = 0x9e3779b97f4a7c15ull;
 
-static double gauss(void)
+static double now(void)
 {
-	double u[2];
-	for (int i = 0; i < 2; i++) {
-		rng ^= rng << 13;
-		rng ^= rng >> 7;
-		rng ^= rng << 17;
-		u[i] = ((rng >> 11) + 0.5) * (1.0 / 9007199254740992.0);
-	}
-	return sqrt(-2.0 * log(u[0])) * cos(6.283185307179586 * u[1]);
+	return bench_clock(CLOCK_MONOTONIC);
 }
 
-static void make_image(float *px, int w, int h)
-{
-	for (int y = 0; y < h; y++)
-		for (int x = 0; x < w; x++) {
-			double X = (double)x / w, Y = (double)y / h;
-			double shade = 0.3 + 0.5 * X * X + 0.2 * Y;
-			double tex = (x / 40 + y / 40) % 2 ? 1.0 : 0.6;
-			double noise = X > 0.5 ? 0.05 : 0.01;
-			for (int c = 0; c < 3; c++)
-				px[((size_t)y * w + x) * 3 + c] =
-					(float)(shade * tex * (1.0 + 0.1 * c) + noise * gauss());
-		}
-}
 
 static double best_time_f(const struct lpr_image *img, const struct lpr_image *feat,
 			  const struct lpr_params *p, int reps)
@@ -83,7 +57,7 @@ int main(int argc, char **argv)
 	float *px = malloc(sizeof(float) * w * h * 3);
 	if (!px)
 		return 1;
-	make_image(px, w, h);
+	bench_image(px, NULL, w, h, &rng);
 	struct lpr_image img = { w, h, 3, px };
 	struct lpr_params p;
 	double mp = w * (double)h / 1e6;

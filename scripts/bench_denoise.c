@@ -10,48 +10,15 @@
  * usage: bench_denoise [W H [REPS]]
  */
 #include "driver/denoise.h"
+#include "scripts/bench.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
 
-static double clock_s(clockid_t id)
-{
-	struct timespec ts;
-	clock_gettime(id, &ts);
-	return ts.tv_sec + ts.tv_nsec * 1e-9;
-}
-
 static unsigned long long rng = 0x9e3779b97f4a7c15ull;
 
-static double gauss(void)
-{
-	double u[2];
-	for (int i = 0; i < 2; i++) {
-		rng ^= rng << 13;
-		rng ^= rng >> 7;
-		rng ^= rng << 17;
-		u[i] = ((rng >> 11) + 0.5) * (1.0 / 9007199254740992.0);
-	}
-	return sqrt(-2.0 * log(u[0])) * cos(6.283185307179586 * u[1]);
-}
-
-static void make_image(float *px, float *var, int w, int h)
-{
-	for (int y = 0; y < h; y++)
-		for (int x = 0; x < w; x++) {
-			double X = (double)x / w, Y = (double)y / h;
-			double shade = 0.3 + 0.5 * X * X + 0.2 * Y;
-			double tex = (x / 40 + y / 40) % 2 ? 1.0 : 0.6;
-			double sd = X > 0.5 ? 0.05 : 0.01;
-			for (int c = 0; c < 3; c++) {
-				size_t i = ((size_t)y * w + x) * 3 + c;
-				px[i] = (float)(shade * tex * (1.0 + 0.1 * c) + sd * gauss());
-				var[i] = (float)(sd * sd);
-			}
-		}
-}
 
 int main(int argc, char **argv)
 {
@@ -69,7 +36,7 @@ int main(int argc, char **argv)
 		fprintf(stderr, "bench_denoise: out of memory for a %dx%d image\n", w, h);
 		return 1;
 	}
-	make_image(px, var, w, h);
+	bench_image(px, var, w, h, &rng);
 	printf("filter (non-local means) of a %dx%d RGB image, best of %d\n", w, h, reps);
 	printf("%-12s %9s %9s %12s\n", "threads", "wall s", "CPU s", "MP/CPU s");
 	const int threads[2] = { 1, 0 };
@@ -80,12 +47,12 @@ int main(int argc, char **argv)
 			char err[256];
 			denoise_params_init(&p);
 			p.nthreads = threads[t];
-			double w0 = clock_s(CLOCK_MONOTONIC), c0 = clock_s(CLOCK_PROCESS_CPUTIME_ID);
+			double w0 = bench_clock(CLOCK_MONOTONIC), c0 = bench_clock(CLOCK_PROCESS_CPUTIME_ID);
 			if (denoise_nlm(w, h, px, var, &p, out, vout, self, err, sizeof err)) {
 				fprintf(stderr, "bench_denoise: %s\n", err);
 				return 1;
 			}
-			double dw = clock_s(CLOCK_MONOTONIC) - w0, dc = clock_s(CLOCK_PROCESS_CPUTIME_ID) - c0;
+			double dw = bench_clock(CLOCK_MONOTONIC) - w0, dc = bench_clock(CLOCK_PROCESS_CPUTIME_ID) - c0;
 			bw = dw < bw ? dw : bw;
 			bc = dc < bc ? dc : bc;
 		}
