@@ -714,12 +714,6 @@ static double quantise(double x, double anchor)
 	return anchor * exp2(round(log2(x / anchor)));
 }
 
-/*
- * Render the whole frame at scale k (antialiasing off, POVPRESS_PASS=0) on
- * the given threads into out, saving the radiosity data to radfile: the
- * base pass and the radiosity pass.  what names it in messages.  Returns 0,
- * -1 on failure (err says why), POV_INTERRUPTED.
- */
 static const struct pov_define pass0 = { "POVPRESS_PASS", "0" };
 
 /* whole_frame()'s job; extra has room for r->nextra + 1. */
@@ -737,6 +731,12 @@ static void frame_job(const struct run *r, int k, int threads, const char *out,
 	job->radiosity_mode = POV_RAD_SAVE;
 }
 
+/*
+ * Render the whole frame at scale k (antialiasing off, POVPRESS_PASS=0) on
+ * the given threads into out, saving the radiosity data to radfile: the
+ * base pass and the radiosity pass.  what names it in messages.  Returns 0,
+ * -1 on failure (err says why), POV_INTERRUPTED.
+ */
 static int whole_frame(struct run *r, int k, int threads, const char *out,
 		       const char *radfile, const char *what, struct pov_result *res, char *err,
 		       size_t errlen)
@@ -976,7 +976,6 @@ static struct pre_kind main_kind(const struct plan *pl, long *area, double *cost
 	return best;
 }
 
-/* Start nb bands of each of the nk kinds for pass `pass` (r->pre). */
 /* Whether renders may be started early now: --prelaunch on, or auto under a
  * budget, none running, and no header of the user's (or an INI file that may
  * set one), whose place the gate would take. */
@@ -990,6 +989,7 @@ static int may_prelaunch(const struct run *r)
 	return 1;
 }
 
+/* Start nb bands of each of the nk kinds for pass `pass` (r->pre). */
 static void prelaunch_start(struct run *r, int pass, const struct pre_kind *kinds, int nk, int nb)
 {
 	if (!may_prelaunch(r) || nk < 1)
@@ -1051,10 +1051,6 @@ static int scene_mentions(const char *path, const char *word)
 	return found;
 }
 
-/* The first pass's guesses, started with the base pass: none for a scene
- * with radiosity, whose region renders load the solution the base pass
- * saves (the early ones could not; stopped, they would only have slowed
- * the base pass). */
 /*
  * For a scene whose file mentions radiosity: the radiosity pass started
  * during the base pass, waiting at its gate, at each scale it may take
@@ -1101,6 +1097,10 @@ static void prelaunch_radiosity(struct run *r)
 			free(extra[k]);
 }
 
+/* The first pass's guesses, started with the base pass: none for a scene
+ * with radiosity, whose region renders load the solution the radiosity pass
+ * saves (the early ones could not; stopped, they would only have slowed
+ * the base pass), but its radiosity pass. */
 static void prelaunch_first(struct run *r)
 {
 	if (scene_mentions(r->scene, "radiosity")) {
