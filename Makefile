@@ -53,7 +53,7 @@ $(BUILD)/bench/bench_analyze: $(BUILD)/scripts/bench_analyze.o $(REG_OBJ) | $(BU
 	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
 
 $(BUILD)/bench/bench_denoise: $(BUILD)/scripts/bench_denoise.o $(BUILD)/driver/denoise.o \
-		$(BUILD)/driver/errbuf.o | $(BUILD)/.deps
+		$(BUILD)/driver/parallel.o $(BUILD)/driver/errbuf.o | $(BUILD)/.deps
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -o $@ $^ $(LDLIBS)
 

@@ -13,9 +13,9 @@
 #include "driver/denoise.h"
 #include "driver/errbuf.h"
 #include "driver/metrics.h"
+#include "driver/parallel.h"
 
 #include <math.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -97,18 +97,27 @@ static inline double term_at(const struct planes *pl, size_t i, size_t q, double
 	return t / 3.0;
 }
 
-/* The terms tr[x], x in [xa, xb), of the pixels from index i against those
- * from index q, where no neighbour is clamped. */
+/* The terms tr[x], x in [xa, xb), of the pixels of the row from index i
+ * against those dx along the row from index q, where no neighbour is
+ * clamped. */
 DENOISE_CLONES
-static void term_row(double *restrict tr, const struct planes *pl, size_t i, size_t q, int xa,
-		     int xb, double k2)
+static void term_row(double *restrict tr, const struct planes *pl, size_t i, size_t q, int dx,
+		     int xa, int xb, double k2)
 {
+	/* from the first pixel whose neighbour is inside: every pointer in
+	 * its array */
+	const int n = xb - xa;
+	if (n <= 0)
+		return;
+	i += (size_t)xa;
+	q += (size_t)(xa + dx);
+	tr += xa;
 	const float *restrict a0 = pl->y[0] + i, *restrict a1 = pl->y[1] + i, *restrict a2 = pl->y[2] + i;
 	const float *restrict q0 = pl->y[0] + q, *restrict q1 = pl->y[1] + q, *restrict q2 = pl->y[2] + q;
 	const float *restrict u0 = pl->v[0] + i, *restrict u1 = pl->v[1] + i, *restrict u2 = pl->v[2] + i;
 	const float *restrict r0 = pl->v[0] + q, *restrict r1 = pl->v[1] + q, *restrict r2 = pl->v[2] + q;
 	const unsigned char *restrict ba = pl->bad + i, *restrict bq = pl->bad + q;
-	for (int x = xa; x < xb; x++) {
+	for (int x = 0; x < n; x++) {
 		double t = 0.0;
 		const double x0 = a0[x], y0 = q0[x], v0 = u0[x], w0 = r0[x];
 		const double x1 = a1[x], y1 = q1[x], v1 = u1[x], w1 = r1[x];
@@ -121,8 +130,18 @@ static void term_row(double *restrict tr, const struct planes *pl, size_t i, siz
 	}
 }
 
-/* hs[x] = the sum of tr[x - f .. x + f] in that order, for x in [xa, xb)
- * (no index clamped), and dst[x] += src[x] on [xa, xb). */
+/* The sum of tr[x - f .. x + f] in that order, each index clamped inside
+ * the row of w. */
+static inline double box_at(const double *tr, int w, int f, int x)
+{
+	double s = 0.0;
+	for (int o = -f; o <= f; o++)
+		s += tr[clampi(x + o, 0, w - 1)];
+	return s;
+}
+
+/* hs[x] = box_at(tr, w, f, x) for x in [xa, xb), where no index is
+ * clamped: the same sums, in the same order. */
 DENOISE_CLONES
 static void box_row(double *restrict hs, const double *restrict tr, int f, int xa, int xb)
 {
@@ -133,6 +152,7 @@ static void box_row(double *restrict hs, const double *restrict tr, int f, int x
 			hs[x] += tr[x + o];
 }
 
+/* dst[x] += src[x] for x in [xa, xb). */
 DENOISE_CLONES
 static void add_row(double *restrict dst, const double *restrict src, int xa, int xb)
 {
@@ -141,38 +161,45 @@ static void add_row(double *restrict dst, const double *restrict src, int xa, in
 }
 
 /*
- * The neighbours' weights wt[x], x in [xa, xb), of the pixels from index i
- * (in the band's sums, planes np apart) on those from index q (in the
- * image's planes) into the sums: num += wt Y, v2 += wt^2 V, den += wt.  A
- * weight of 0 is no neighbour: its value, perhaps not finite, is not read
- * into the sums.
+ * The neighbours' weights wt[x], x in [xa, xb), of the pixels of the row
+ * from index i (in the band's sums, planes np apart) on those dx along the
+ * row from index q (in the image's planes) into the sums: num += wt Y,
+ * v2 += wt^2 V, den += wt.  A weight of 0 is no neighbour: its value,
+ * perhaps not finite, is not read into the sums.
  */
 DENOISE_CLONES
 static void add_weighted(double *restrict num, double *restrict v2, double *restrict den,
 			 const struct planes *pl, const double *restrict wt, size_t i, size_t q,
-			 size_t np, int xa, int xb)
+			 int dx, size_t np, int xa, int xb)
 {
+	/* from the first pixel whose neighbour is inside: every pointer in
+	 * its array */
+	const int n = xb - xa;
+	if (n <= 0)
+		return;
+	i += (size_t)xa;
+	q += (size_t)(xa + dx);
+	wt += xa;
 	for (int c = 0; c < 3; c++) {
 		double *restrict nc = num + np * c + i, *restrict vc = v2 + np * c + i;
 		const float *restrict yc = pl->y[c] + q, *restrict uc = pl->v[c] + q;
-		for (int x = xa; x < xb; x++) {
+		for (int x = 0; x < n; x++) {
 			const double k = wt[x], yv = yc[x], vv = uc[x];
 			nc[x] += k > 0.0 ? k * yv : 0.0;
 			vc[x] += k > 0.0 ? k * k * vv : 0.0;
 		}
 	}
-	for (int x = xa; x < xb; x++)
+	for (int x = 0; x < n; x++)
 		den[i + x] += wt[x];
 }
 
-/* A band's buffers for a chunk of up to `rows` rows (filter_rows()). */
+/* A band's buffers for a chunk of rows (filter_rows()). */
 struct scratch {
-	int rows;
 	double *t, *hs, *ds, *num, *v2, *den, *own;
 };
 
 /*
- * Rows [y0, y1) of the band's image, at most s->rows of them: for each
+ * Rows [y0, y1) of the band's image, as many as sc has room for: for each
  * offset of the search window, the terms of the rows and `patch` rows
  * beyond on both sides, their patch sums, and the weights they give added
  * to the rows' sums; then the rows' means.  A chunk of rows keeps its sums
@@ -195,42 +222,33 @@ static void filter_rows(const struct band *b, int y0, int y1, const struct scrat
 	memset(own, 0, sizeof(double) * np);
 	for (int dy = -R; dy <= R; dy++)
 		for (int dx = -R; dx <= R; dx++) {
-			/* x in [xa, xb): the neighbour x + dx inside the row */
-			const int xa = dx < 0 ? -dx : 0, xb = dx > 0 ? w - dx : w;
+			/* x in [xa, xb): the neighbour x + dx inside the row
+			 * (none when |dx| >= w: xa = xb = w) */
+			int xa = dx < 0 ? -dx : 0, xb = dx > 0 ? w - dx : w;
+			if (xa >= xb)
+				xa = xb = w;
 			for (int r = 0; r < nr; r++) {
 				const int y = clampi(y0 - f + r, 0, b->h - 1);
 				const int qy = clampi(y + dy, 0, b->h - 1);
 				const size_t row = (size_t)y * w, qrow = (size_t)qy * w;
 				double *tr = t + (size_t)r * w;
-				if (xa < xb) {
-					for (int x = 0; x < xa; x++)
-						tr[x] = term_at(pl, row + x, qrow + clampi(x + dx, 0, w - 1), k2);
-					term_row(tr, pl, row, qrow + dx, xa, xb, k2);
-					for (int x = xb; x < w; x++)
-						tr[x] = term_at(pl, row + x, qrow + clampi(x + dx, 0, w - 1), k2);
-				} else {
-					for (int x = 0; x < w; x++)
-						tr[x] = term_at(pl, row + x, qrow + clampi(x + dx, 0, w - 1), k2);
-				}
+				for (int x = 0; x < xa; x++)
+					tr[x] = term_at(pl, row + x, qrow + clampi(x + dx, 0, w - 1), k2);
+				term_row(tr, pl, row, qrow, dx, xa, xb, k2);
+				for (int x = xb; x < w; x++)
+					tr[x] = term_at(pl, row + x, qrow + clampi(x + dx, 0, w - 1), k2);
 			}
 			/* the patch's horizontal sums: its columns beyond the
-			 * border are the border's */
+			 * border are the border's (clamped within f of it) */
 			const int ha = f < w ? f : w, hb = w - f > ha ? w - f : ha;
 			for (int r = 0; r < nr; r++) {
 				const double *tr = t + (size_t)r * w;
 				double *hr = hs + (size_t)r * w;
-				for (int x = 0; x < w; x++) {
-					if (x == ha) {
-						box_row(hr, tr, f, ha, hb);
-						x = hb;
-						if (x >= w)
-							break;
-					}
-					double s = 0.0;
-					for (int o = -f; o <= f; o++)
-						s += tr[clampi(x + o, 0, w - 1)];
-					hr[x] = s;
-				}
+				for (int x = 0; x < ha; x++)
+					hr[x] = box_at(tr, w, f, x);
+				box_row(hr, tr, f, ha, hb);
+				for (int x = hb; x < w; x++)
+					hr[x] = box_at(tr, w, f, x);
 			}
 			for (int j = 0; j < nb; j++) {
 				const int y = y0 + j, qy = y + dy;
@@ -246,8 +264,8 @@ static void filter_rows(const struct band *b, int y0, int y1, const struct scrat
 					 * term_at()) */
 					ds[x] = d >= 40.0 ? 0.0 : d > 0.0 ? exp(-d) : 1.0;
 				}
-				const size_t i = (size_t)j * w, q = (size_t)qy * w + dx;
-				add_weighted(num, v2, den, pl, ds, i, q, np, xa, xb);
+				const size_t i = (size_t)j * w, q = (size_t)qy * w;
+				add_weighted(num, v2, den, pl, ds, i, q, dx, np, xa, xb);
 				if (!dx && !dy)
 					memcpy(own + i + xa, ds + xa, sizeof(double) * (size_t)(xb - xa));
 			}
@@ -289,8 +307,7 @@ static void *run_band(void *arg)
 	rows = rows < 8 ? 8 : rows;
 	rows = rows > nb ? nb : rows;
 	const size_t nr = (size_t)rows + 2 * f, np = (size_t)rows * w;
-	struct scratch sc = { rows,
-			      malloc(sizeof(double) * nr * w), malloc(sizeof(double) * nr * w),
+	struct scratch sc = { malloc(sizeof(double) * nr * w), malloc(sizeof(double) * nr * w),
 			      malloc(sizeof(double) * (size_t)w), malloc(sizeof(double) * np * 3),
 			      malloc(sizeof(double) * np * 3), malloc(sizeof(double) * np),
 			      malloc(sizeof(double) * np) };
@@ -331,26 +348,13 @@ int denoise_nlm(int w, int h, const float *rgb, const float *var,
 	/* bands of at least 16 rows: each computes 2 patch rows of terms twice */
 	if (nth > h / 16)
 		nth = h / 16 > 0 ? h / 16 : 1;
-	struct band *bs = calloc((size_t)nth, sizeof *bs);
-	pthread_t *tid = calloc((size_t)nth, sizeof *tid);
-	int started = 0, failed = 0;
-	if (!bs || !tid) {
-		free(bs);
-		free(tid);
-		errbuf_printf(err, errlen, "out of memory filtering a %dx%d image", w, h);
-		return -1;
-	}
 	const size_t npx = (size_t)w * h;
+	struct band *bs = calloc((size_t)nth, sizeof *bs);
 	float *pv = malloc(sizeof(float) * npx * 6);
 	unsigned char *bad = malloc(npx);
-	if (!pv || !bad) {
-		free(pv);
-		free(bad);
-		free(bs);
-		free(tid);
-		errbuf_printf(err, errlen, "out of memory filtering a %dx%d image", w, h);
-		return -1;
-	}
+	int failed = !bs || !pv || !bad;
+	if (failed)
+		goto out;
 	struct planes pl;
 	for (int c = 0; c < 3; c++) {
 		float *yc = pv + npx * c, *vc = pv + npx * (3 + c);
@@ -368,23 +372,13 @@ int denoise_nlm(int w, int h, const float *rgb, const float *var,
 		bs[k] = (struct band){ w, h, (int)((long)h * k / nth), (int)((long)h * (k + 1) / nth),
 				       rgb, var, &pl, p, out, vout, self, 0 };
 	}
-	for (int k = 1; k < nth; k++) {
-		if (pthread_create(&tid[k], NULL, run_band, &bs[k]))
-			break;
-		started = k;
-	}
-	/* bands whose thread did not start run here */
-	run_band(&bs[0]);
-	for (int k = started + 1; k < nth; k++)
-		run_band(&bs[k]);
-	for (int k = 1; k <= started; k++)
-		pthread_join(tid[k], NULL);
+	parallel_run(run_band, bs, sizeof *bs, nth);
 	for (int k = 0; k < nth; k++)
 		failed |= bs[k].failed;
+out:
 	free(pv);
 	free(bad);
 	free(bs);
-	free(tid);
 	if (failed) {
 		errbuf_printf(err, errlen, "out of memory filtering a %dx%d image", w, h);
 		return -1;

@@ -6,11 +6,11 @@
 #include "driver/errbuf.h"
 #include "driver/files.h"
 #include "driver/metrics.h"
+#include "driver/parallel.h"
 
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -87,15 +87,15 @@ static double diff_around(const struct image *acc, const double *lmv, int x, int
 	return wsum > 0.0 ? sum / wsum : NAN;
 }
 
-/* Rows [y0, y1) of plan_pixel_errors(), on a thread of their own. */
+/* Rows [y0, y1) of plan_pixel_errors(), on a thread of their own: in
+ * stage 0 the logarithms of their pixels' mean variances (lmv), in stage 1
+ * (once every band's are there) their errors. */
 struct err_band {
 	const struct image *acc;
 	const float *press, *fit;
-	double *e, *noise;
-	const double *lmv;
+	double *e, *noise, *lmv;
 	int y0, y1;
-	int stage;	/* 0: lmv of the rows, 1: their errors */
-	double *lmv_out;
+	int stage;
 };
 
 static void *err_band_run(void *arg)
@@ -105,7 +105,7 @@ static void *err_band_run(void *arg)
 	const size_t i0 = (size_t)b->y0 * acc->w, i1 = (size_t)b->y1 * acc->w;
 	if (b->stage == 0) {
 		for (size_t i = i0; i < i1; i++)	/* ln of each, once: 25 neighbours use it */
-			b->lmv_out[i] = log(mean_var(acc->px + i * ACC_NCH));
+			b->lmv[i] = log(mean_var(acc->px + i * ACC_NCH));
 		return NULL;
 	}
 	for (size_t i = i0; i < i1; i++) {
@@ -118,25 +118,6 @@ static void *err_band_run(void *arg)
 			b->noise[i] = ns;
 	}
 	return NULL;
-}
-
-/* Run stage of the bands, one thread each but the first (here); a band
- * whose thread does not start runs here too. */
-static void err_bands_run(struct err_band *bs, int n, int stage)
-{
-	pthread_t tid[PLAN_MAX_THREADS];
-	int started[PLAN_MAX_THREADS] = { 0 };
-	for (int k = 0; k < n; k++)
-		bs[k].stage = stage;
-	for (int k = 1; k < n; k++)
-		started[k] = pthread_create(&tid[k], NULL, err_band_run, &bs[k]) == 0;
-	err_band_run(&bs[0]);
-	for (int k = 1; k < n; k++) {
-		if (started[k])
-			pthread_join(tid[k], NULL);
-		else
-			err_band_run(&bs[k]);
-	}
 }
 
 int plan_pixel_errors_threads(const struct image *acc, const float *press, const float *fit,
@@ -156,12 +137,13 @@ int plan_pixel_errors_threads(const struct image *acc, const float *press, const
 	if (nb > acc->h / 64)
 		nb = acc->h / 64 > 1 ? acc->h / 64 : 1;
 	struct err_band bs[PLAN_MAX_THREADS];
-	for (int k = 0; k < nb; k++)
-		bs[k] = (struct err_band){ acc, press, fit, e, noise, lmv,
-					   (int)((long)acc->h * k / nb), (int)((long)acc->h * (k + 1) / nb),
-					   0, lmv };
-	err_bands_run(bs, nb, 0);
-	err_bands_run(bs, nb, 1);
+	for (int stage = 0; stage < 2; stage++) {
+		for (int k = 0; k < nb; k++)
+			bs[k] = (struct err_band){ acc, press, fit, e, noise, lmv,
+						   (int)((long)acc->h * k / nb),
+						   (int)((long)acc->h * (k + 1) / nb), stage };
+		parallel_run(err_band_run, bs, sizeof *bs, nb);
+	}
 	free(lmv);
 	/* summed in pixel order, whatever the threads: the same estimate */
 	double sum = 0.0;

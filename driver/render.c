@@ -715,6 +715,12 @@ static double quantise(double x, double anchor)
 	return anchor * exp2(round(log2(x / anchor)));
 }
 
+/* Whether the radiosity pass at scale k was started early (r->pre). */
+static int rad_prelaunched(const struct run *r, int k)
+{
+	return k >= 0 && k < 32 && (r->pre_rad >> k & 1u);
+}
+
 static const struct pov_define pass0 = { "POVPRESS_PASS", "0" };
 
 /* whole_frame()'s job; extra has room for r->nextra + 1. */
@@ -755,7 +761,7 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
 	/* the radiosity pass, if it was started early at this scale (a pool
 	 * given the early renders stops those it does not take: not the base
 	 * pass's) */
-	po.prelaunched = k < 32 && (r->pre_rad >> k & 1u) ? r->pre : NULL;
+	po.prelaunched = rad_prelaunched(r, k) ? r->pre : NULL;
 	po.timeout_s = r->timeout > 0 ? r->timeout : 0.0;
 	double written = 0.0;
 	po.ready = note_written;
@@ -816,7 +822,7 @@ static double radiosity_time(const struct run *r, int k)
 	/* a whole-frame render waits for POV-Ray's exit: the latency and the
 	 * tail the region renders do not wait on; one started early waits
 	 * only from its gate */
-	const double lat = k < 32 && (r->pre_rad >> k & 1u) ? r->pre_latency : r->latency;
+	const double lat = rad_prelaunched(r, k) ? r->pre_latency : r->latency;
 	return lat + r->tail + r->cost_sample_measured * k * k * (double)r->w * r->h;
 }
 
@@ -1085,39 +1091,30 @@ static void prelaunch_radiosity(struct run *r)
 	const int top = radiosity_scale(r);
 	/* without a budget too: the one scale it renders at is taken whenever
 	 * the scene has radiosity, and saves POV-Ray's start-up wait
-	 * (radiosity_room at 160x120, --target 3e-3: 2.03 s wall against 2.61
-	 * s, the same image) */
+	 * (radiosity_room at 160x120, --target 3e-3: 1.99 to 2.15 s wall
+	 * against 2.23 to 2.34 s with --prelaunch off, the same image) */
 	if (!may_prelaunch_any(r) || top < 2)
 		return;
 	const int low = r->user_rad_scale < 0 && r->budget > 0.0 ? 2 : top;
 	enum { NRAD = 3 };
 	struct pov_job jobs[NRAD];
-	const char *extras[NRAD][64];
-	const char **extra[NRAD];
+	const size_t ne = r->nextra + 1;	/* frame_job() adds one */
+	const char **extras = calloc(NRAD * ne, sizeof(char *));
 	char out[PATH_MAX], rad[PATH_MAX + 16];
 	snprintf(out, sizeof out, "%s", wpath(r, "radiosity.exr"));
 	snprintf(rad, sizeof rad, "%s/radiosity-new.rca", r->workdir);
 	unsigned mask = 0;
 	size_t n = 0;
-	for (int k = top; k >= low && n < NRAD; k--) {
-		extra[n] = r->nextra + 1 <= 64 ? extras[n] : calloc(r->nextra + 1, sizeof(char *));
-		if (!extra[n])
-			break;
-		frame_job(r, k, 1, out, rad, &jobs[n], extra[n]);
+	for (int k = top; extras && k >= low && n < NRAD; k--, n++) {
+		frame_job(r, k, 1, out, rad, &jobs[n], extras + n * ne);
 		mask |= 1u << k;
-		n++;
 	}
 	char err[512];
-	if (n && pov_prelaunch_start(jobs, n, r->povdir, &r->pre, err, sizeof err) == 0) {
+	if (n && pov_prelaunch_start(jobs, n, r->povdir, &r->pre, err, sizeof err) == 0)
 		r->pre_rad = mask;
-		r->npre = 0;	/* no region renders */
-		r->pre_pass = 0;
-	} else if (n && r->verbose) {
+	else if (n && r->verbose)
 		fprintf(stderr, "povpress render: no radiosity pass started early: %s\n", err);
-	}
-	for (size_t k = 0; k < n; k++)
-		if (extra[k] != extras[k])
-			free(extra[k]);
+	free(extras);
 }
 
 /* The first pass's guesses, started with the base pass: none for a scene
@@ -1306,23 +1303,20 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	 * radiosity pass serves only a scene that has radiosity */
 	if (r->radiosity != (r->pre_rad != 0))
 		p.cpu_s += prelaunch_end(r);
-	int k = r->radiosity ? radiosity_scale(r) : 0;
-	if (k > 1 || (k == 1 && r->cores > 1)) {
-		int rrc = radiosity_pass(r, k, &p, err, errlen);
-		if (r->pre_rad) {
-			p.prelaunched = (int)pov_prelaunch_taken(r->pre);
-			if (r->verbose)
-				fprintf(stderr, "povpress render: the radiosity pass %s\n",
-					p.prelaunched ? "was started early" : "started afresh");
-			p.cpu_s += prelaunch_end(r);	/* the scales not taken */
-		}
-		if (rrc == POV_INTERRUPTED || rrc < 0) {
-			ret = rrc;
-			goto out;
-		}
-	}
-	if (r->pre_rad)
+	int k = r->radiosity ? radiosity_scale(r) : 0, rrc = 0;
+	if (k > 1 || (k == 1 && r->cores > 1))
+		rrc = radiosity_pass(r, k, &p, err, errlen);
+	if (r->pre_rad) {	/* the scales not taken stop */
+		p.prelaunched = (int)pov_prelaunch_taken(r->pre);
+		if (r->verbose)
+			fprintf(stderr, "povpress render: the radiosity pass %s\n",
+				p.prelaunched ? "was started early" : "took no render started early");
 		p.cpu_s += prelaunch_end(r);
+	}
+	if (rrc == POV_INTERRUPTED || rrc < 0) {
+		ret = rrc;
+		goto out;
+	}
 	p.driver_cpu_s = self_cpu() - c;
 	if (add_pass(r, &p)) {
 		errbuf_printf(err, errlen, "out of memory");
