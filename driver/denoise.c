@@ -97,21 +97,16 @@ static inline double term_at(const struct planes *pl, size_t i, size_t q, double
 	return t / 3.0;
 }
 
-/* The terms tr[x], x in [xa, xb), of the pixels of the row from index i
- * against those dx along the row from index q, where no neighbour is
- * clamped. */
+/* The terms tr[x], x in [0, n), of the n pixels from index i against the n
+ * from index q (their neighbours, none clamped).  The callers pass the
+ * first pixel whose neighbour is inside, so that every pointer lies in its
+ * array. */
 DENOISE_CLONES
-static void term_row(double *restrict tr, const struct planes *pl, size_t i, size_t q, int dx,
-		     int xa, int xb, double k2)
+static void term_row(double *restrict tr, const struct planes *pl, size_t i, size_t q, int n,
+		     double k2)
 {
-	/* from the first pixel whose neighbour is inside: every pointer in
-	 * its array */
-	const int n = xb - xa;
 	if (n <= 0)
 		return;
-	i += (size_t)xa;
-	q += (size_t)(xa + dx);
-	tr += xa;
 	const float *restrict a0 = pl->y[0] + i, *restrict a1 = pl->y[1] + i, *restrict a2 = pl->y[2] + i;
 	const float *restrict q0 = pl->y[0] + q, *restrict q1 = pl->y[1] + q, *restrict q2 = pl->y[2] + q;
 	const float *restrict u0 = pl->v[0] + i, *restrict u1 = pl->v[1] + i, *restrict u2 = pl->v[2] + i;
@@ -161,25 +156,20 @@ static void add_row(double *restrict dst, const double *restrict src, int xa, in
 }
 
 /*
- * The neighbours' weights wt[x], x in [xa, xb), of the pixels of the row
- * from index i (in the band's sums, planes np apart) on those dx along the
- * row from index q (in the image's planes) into the sums: num += wt Y,
- * v2 += wt^2 V, den += wt.  A weight of 0 is no neighbour: its value,
- * perhaps not finite, is not read into the sums.
+ * The neighbours' weights wt[x], x in [0, n), of the n pixels from index i
+ * (in the band's sums, planes np apart) on the n from index q (in the
+ * image's planes) into the sums: num += wt Y, v2 += wt^2 V, den += wt.  A
+ * weight of 0 is no neighbour: its value, perhaps not finite, is not read
+ * into the sums.  As for term_row(), the first pixel is one whose
+ * neighbour is inside.
  */
 DENOISE_CLONES
 static void add_weighted(double *restrict num, double *restrict v2, double *restrict den,
 			 const struct planes *pl, const double *restrict wt, size_t i, size_t q,
-			 int dx, size_t np, int xa, int xb)
+			 size_t np, int n)
 {
-	/* from the first pixel whose neighbour is inside: every pointer in
-	 * its array */
-	const int n = xb - xa;
 	if (n <= 0)
 		return;
-	i += (size_t)xa;
-	q += (size_t)(xa + dx);
-	wt += xa;
 	for (int c = 0; c < 3; c++) {
 		double *restrict nc = num + np * c + i, *restrict vc = v2 + np * c + i;
 		const float *restrict yc = pl->y[c] + q, *restrict uc = pl->v[c] + q;
@@ -234,7 +224,7 @@ static void filter_rows(const struct band *b, int y0, int y1, const struct scrat
 				double *tr = t + (size_t)r * w;
 				for (int x = 0; x < xa; x++)
 					tr[x] = term_at(pl, row + x, qrow + clampi(x + dx, 0, w - 1), k2);
-				term_row(tr, pl, row, qrow, dx, xa, xb, k2);
+				term_row(tr + xa, pl, row + xa, qrow + xa + dx, xb - xa, k2);
 				for (int x = xb; x < w; x++)
 					tr[x] = term_at(pl, row + x, qrow + clampi(x + dx, 0, w - 1), k2);
 			}
@@ -264,10 +254,10 @@ static void filter_rows(const struct band *b, int y0, int y1, const struct scrat
 					 * term_at()) */
 					ds[x] = d >= 40.0 ? 0.0 : d > 0.0 ? exp(-d) : 1.0;
 				}
-				const size_t i = (size_t)j * w, q = (size_t)qy * w;
-				add_weighted(num, v2, den, pl, ds, i, q, dx, np, xa, xb);
+				const size_t i = (size_t)j * w + xa, q = (size_t)qy * w + xa + dx;
+				add_weighted(num, v2, den, pl, ds + xa, i, q, np, xb - xa);
 				if (!dx && !dy)
-					memcpy(own + i + xa, ds + xa, sizeof(double) * (size_t)(xb - xa));
+					memcpy(own + i, ds + xa, sizeof(double) * (size_t)(xb - xa));
 			}
 		}
 	for (int j = 0; j < nb; j++)
