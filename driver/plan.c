@@ -24,6 +24,7 @@ void plan_params_init(struct plan_params *p)
 	p->max_regions = 64;
 	p->tile = 8;
 	p->min_gain = 0.05;
+	p->grid_frame = PLAN_GRID_FRAME;
 }
 
 const char *plan_outcome_name(enum plan_outcome o)
@@ -363,7 +364,7 @@ int plan_grid_parse(const char *name)
 int plan_grid_scale(const struct plan_params *p, int w, int h, int s)
 {
 	return s >= 4 && (p->grid == PLAN_GRID_ALWAYS || p->grid == PLAN_GRID_ONLY ||
-			  (p->grid == PLAN_GRID_LARGE && (double)s * s * w * h > PLAN_GRID_FRAME));
+			  (p->grid == PLAN_GRID_LARGE && (double)s * s * w * h > p->grid_frame));
 }
 
 /* The first scale past cur that pixel i may be refined at: unused, and

@@ -41,6 +41,9 @@ struct plan_params {
 				 * is not refined (default 0.05) */
 	int grid;		/* which of scales 4, 8, 16 are grid renders
 				 * (accum.h): PLAN_GRID_* (default NEVER) */
+	double grid_frame;	/* under PLAN_GRID_LARGE, the scaled frame, in
+				 * pixels, past which a scale is a grid render
+				 * (default PLAN_GRID_FRAME) */
 	double fill;		/* when the pixels at their next scales leave
 				 * the goal unmet and cost less than this, take
 				 * chosen pixels on to later scales until the
@@ -56,11 +59,14 @@ struct plan_params {
 };
 
 /* Grid renders: never (resolution scaling), for every scale of 4 or more,
- * or for those whose scaled frame would exceed PLAN_GRID_FRAME pixels; or
+ * or for those whose scaled frame would exceed grid_frame pixels
+ * (PLAN_GRID_FRAME, or PLAN_FOCAL_FRAME where render's --sampler auto finds
+ * focal blur: POV-Ray's antialiasing converges slowly there); or
  * (PLAN_GRID_ONLY) for every scale of 4 or more with no scale 2 before
  * them, so that every sample added to the base pass is jittered. */
 enum { PLAN_GRID_NEVER, PLAN_GRID_ALWAYS, PLAN_GRID_LARGE, PLAN_GRID_ONLY };
 #define PLAN_GRID_FRAME (1024.0 * 1024.0)
+#define PLAN_FOCAL_FRAME (8.0 * 1024 * 1024)
 /* The largest frame a region render may have, pixels (a 4096 x 8192 frame:
  * 320x240 at scale 16, 640x480 at 8, 1920x1080 at 4). */
 #define PLAN_MAX_FRAME (32.0 * 1024 * 1024)

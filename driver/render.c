@@ -23,6 +23,7 @@
 #include "driver/povray.h"
 #include "regression/lpr.h"
 
+#include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
 #include <limits.h>
@@ -102,9 +103,12 @@ static const char usage_options[] =
 	"  --report FILE         JSON report of every pass (default: none)\n"
 	"  --sampler S           how pixels get their samples: auto (default: grid for\n"
 	"                        the scales whose scaled frame would exceed 1 Mpixel,\n"
-	"                        scale below; and where the estimated error sits in a\n"
-	"                        few pixels, 0.1% of them holding half of it, as at\n"
-	"                        highlights, scale 2 as one render at twice the size\n"
+	"                        scale below, or 8 Mpixels for a scene whose file has\n"
+	"                        focal blur (aperture and blur_samples), where\n"
+	"                        POV-Ray's antialiasing converges slowly; where the\n"
+	"                        estimated error sits in a few pixels, 0.1% of them\n"
+	"                        holding half of it, as at highlights, scale 2 as\n"
+	"                        one render at twice the size\n"
 	"                        with POV-Ray's +AM2 +A0.1 +R3 +J; where it is spread\n"
 	"                        and the frame at scale 4 costs less than the cores\n"
 	"                        wait on POV-Ray's latency in a pass, as jitter), grid\n"
@@ -212,6 +216,9 @@ struct run {
 	int rad_scale;		/* the scale the radiosity solution was computed at */
 	int jittered;		/* --sampler auto chose PLAN_GRID_ONLY for the run
 				 * (one_step()) */
+	int focal;		/* --sampler auto and the scene has focal blur
+				 * (scene_focal_blur()): resolution scaling up to
+				 * PLAN_FOCAL_FRAME, no jitter */
 	struct pass_rec *passes;
 	size_t npasses;
 	const char *stop;
@@ -675,11 +682,11 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 	json_str(f, r->stop ? r->stop : "");
 	fprintf(f, ",\n  \"cost_model\": {\"job_s\": %.17g, \"sample_s\": %.17g, "
 		"\"latency_s\": %.6g, \"scale\": %.4g},\n  \"radiosity\": %s,\n"
-		"  \"radiosity_scale\": %d,\n"
+		"  \"radiosity_scale\": %d,\n  \"focal_blur\": %s,\n"
 		"  \"sampler\": \"%s\",\n  \"sampler_chosen\": \"%s\",\n  \"prelaunch\": \"%s\",\n"
 		"  \"final\": \"%s\",\n  \"passes\": [\n",
 		r->cost_job, r->cost_sample, r->latency, cost_scale(r), r->radiosity ? "true" : "false",
-		r->rad_scale, r->aa ? "aa" : plan_grid_name(r->grid),
+		r->rad_scale, r->focal ? "true" : "false", r->aa ? "aa" : plan_grid_name(r->grid),
 		r->aa ? "aa" : plan_grid_name(run_grid(r)),
 		prelaunch_names[r->prelaunch],
 		r->final == ACC_FINAL_AUTO && !r->filter ? "blend" : final_names[r->final]);
@@ -1076,6 +1083,60 @@ static int scene_mentions(const char *path, const char *word)
 	return found;
 }
 
+/* Whether word w starts at t[i] as a word of the scene language. */
+static int word_at(const char *t, size_t i, const char *w)
+{
+	size_t n = strlen(w);
+	if (strncmp(t + i, w, n))
+		return 0;
+	int before = i > 0 && (isalnum((unsigned char)t[i - 1]) || t[i - 1] == '_');
+	int after = isalnum((unsigned char)t[i + n]) || t[i + n] == '_';
+	return !before && !after;
+}
+
+/*
+ * Whether the scene file (not what it includes) names both of focal blur's
+ * camera keywords, aperture and blur_samples, outside comments.  There
+ * POV-Ray's antialiasing converges far more slowly than resolution scaling:
+ * each antialiasing sub-sample traces its own blur samples, whose sub-pixel
+ * offsets come from a table indexed by the position (tracepixel.cpp), so
+ * the sub-samples of a pixel share much of their pattern.  focal_blur at
+ * 160x120, the whole frame against the sweep's reference: +AM1 +A0.0 +R8
+ * +J0.75 at twice the size (256 samples a pixel) 7.8e-5, resolution
+ * scaling at 8 (64) 7.8e-5 and at 16 (256) 2.3e-5; on the other bundled
+ * scenes the grid renders did as well as scaling or better (README).
+ */
+static int scene_focal_blur(const char *path)
+{
+	char *t = file_read_text(path);
+	if (!t)
+		return 0;
+	int ap = 0, bs = 0;
+	for (size_t i = 0; t[i]; i++) {
+		if (t[i] == '/' && t[i + 1] == '/') {
+			while (t[i + 1] && t[i + 1] != '\n')
+				i++;
+		} else if (t[i] == '/' && t[i + 1] == '*') {
+			i += 2;
+			while (t[i] && !(t[i] == '*' && t[i + 1] == '/'))
+				i++;
+			if (!t[i])
+				break;
+			i++;
+		} else if (t[i] == '"') {
+			while (t[i + 1] && t[i + 1] != '"' && t[i + 1] != '\n')
+				i++;
+			if (t[i + 1])
+				i++;
+		} else {
+			ap |= word_at(t, i, "aperture");
+			bs |= word_at(t, i, "blur_samples");
+		}
+	}
+	free(t);
+	return ap && bs;
+}
+
 /*
  * For a scene whose file mentions radiosity: the radiosity pass started
  * during the base pass, waiting at its gate, at each scale it may take
@@ -1131,7 +1192,7 @@ static void prelaunch_first(struct run *r)
 	int nk = 0;
 	if (r->grid != PLAN_GRID_ONLY)
 		kinds[nk++] = (struct pre_kind){ 2, 0 };
-	if (r->grid != PLAN_GRID_NEVER)
+	if (r->grid != PLAN_GRID_NEVER && !r->focal)	/* one_step()'s jitter */
 		kinds[nk++] = (struct pre_kind){ 4, ACC_GRID_FRAME };
 	if (r->grid == PLAN_GRID_LARGE && !r->aa)
 		kinds[nk++] = (struct pre_kind){ ACC_AA, ACC_GRID_FRAME };
@@ -1428,7 +1489,7 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
 static int one_step(const struct run *r, int *sparse)
 {
 	const double frame4 = 16.0 * r->cost_sample * (double)r->w * r->h;
-	return r->grid == PLAN_GRID_LARGE && r->npasses == 1 && !r->radiosity &&
+	return r->grid == PLAN_GRID_LARGE && r->npasses == 1 && !r->radiosity && !r->focal &&
 	       frame4 < r->latency * r->cores && !sparse_error(r, sparse);
 }
 
@@ -1509,6 +1570,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 				pp.fill = fit <= 1 ? pp.budget : pp.budget / fit;
 		}
 		pp.grid = choose ? PLAN_GRID_ONLY : run_grid(r);
+		if (r->focal)
+			pp.grid_frame = PLAN_FOCAL_FRAME;
 		pp.min_split = r->cores;
 		/* under a budget, a pass that leaves the target unmet and
 		 * would take less than 1% of the error off is not worth
@@ -1924,6 +1987,7 @@ bad:
 			      strerror(errno));
 		goto fail_early;
 	}
+	r.focal = r.grid == PLAN_GRID_LARGE && !r.aa && scene_focal_blur(r.scene);
 	{
 		struct pov_job probe = { .scene = r.scene };
 		char bin[PATH_MAX];

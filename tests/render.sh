@@ -292,6 +292,40 @@ else
 	bad "soft_shadows: reference render failed"
 fi
 
+# --- --sampler auto with focal blur: resolution scaling to larger frames -----
+# POV-Ray's antialiasing converges slowly on focal blur (each sub-sample
+# draws its blur offsets from a position-keyed table), so auto keeps scaling
+# up to 8 Mpixel frames there: at 320x240 scale 4 (1280x960) is four times
+# the width rather than a grid render at twice it.  The keywords count only
+# outside comments and strings.
+cat >"$T/focal.pov" <<'EOF'
+#version 3.7;
+global_settings { assumed_gamma 1.0 }
+camera { location <0, 1, -3> look_at <0, 0.5, 0>
+	aperture 0.4 blur_samples 2 focal_point <0, 0.5, 0> }
+light_source { <2, 4, -3> rgb 1 }
+plane { y, 0 pigment { checker rgb 0.1 rgb 0.9 } }
+sphere { <0, 0.5, 0>, 0.5 pigment { rgb <1, 0.3, 0.2> } }
+EOF
+sed 's|^\taperture.*|\t// aperture 0.4 blur_samples 2\n\t/* aperture */ #debug "blur_samples" }|' \
+	"$T/focal.pov" >"$T/nofocal.pov"
+"$PP" render "$T/focal.pov" -o "$T/focal.exr" -W 320 -H 240 --target 2e-3 --max-passes 2 -q \
+	--keep-workdir --report "$T/focal.json" -- +WT1 || bad "focal blur: render failed"
+check "focal blur: the report says the scene has it" grep -q '"focal_blur": true' "$T/focal.json"
+f4=$(compgen -G "$T/focal.exr.work/p02-*-s4.exr" | head -n 1)
+check "focal blur: scale 4 at 320x240 by resolution scaling, four times the width" \
+	grep -q "1280 x *960" <(iinfo "$f4" 2>&1)
+for f in nofocal:"$T/nofocal.pov" bundled:"$SC/focal_blur.pov"; do
+	"$PP" render "${f#*:}" -o "$T/${f%%:*}.exr" -W 40 -H 30 --max-passes 0 -q \
+		--report "$T/${f%%:*}.json" -- +WT1 || bad "focal blur (${f%%:*}): render failed"
+done
+check "focal blur: keywords only in comments and strings are not focal blur" \
+	grep -q '"focal_blur": false' "$T/nofocal.json"
+check "focal blur: scenes/focal_blur.pov has it" grep -q '"focal_blur": true' "$T/bundled.json"
+"$PP" render "$SC/focal_blur.pov" -o "$T/fb-grid.exr" -W 40 -H 30 --max-passes 0 -q --sampler grid \
+	--report "$T/fb-grid.json" -- +WT1 || bad "focal blur, --sampler grid: render failed"
+check "focal blur: only --sampler auto looks for it" grep -q '"focal_blur": false' "$T/fb-grid.json"
+
 # --- --sampler auto where the error sits in a few pixels: antialiasing first -
 # hdr_highlights' lamps and their reflections hold half the base pass's
 # estimated error in 0.1% of the pixels at 160x120 (at 80x60, 0.1% is 4

@@ -1684,6 +1684,16 @@ static void test_plan_job(void **state)
 	assert_false(plan_grid_scale(&pp, 512, 512, 2));
 	assert_false(plan_grid_scale(&pp, 256, 256, 4));	/* exactly 1 Mpixel */
 	assert_true(plan_grid_scale(&pp, 640, 480, 4));
+	/* focal blur: scaling up to 8 Mpixel frames */
+	pp.grid_frame = PLAN_FOCAL_FRAME;
+	assert_false(plan_grid_scale(&pp, 160, 120, 8));	/* 1280x960 */
+	assert_false(plan_grid_scale(&pp, 160, 120, 16));	/* 2560x1920 */
+	assert_false(plan_grid_scale(&pp, 640, 480, 4));	/* 2560x1920 */
+	assert_true(plan_grid_scale(&pp, 320, 240, 16));	/* 5120x3840 */
+	assert_true(plan_grid_scale(&pp, 1280, 720, 4));	/* 5120x2880 */
+	pp.grid = PLAN_GRID_ALWAYS;	/* the frame matters to auto alone */
+	assert_true(plan_grid_scale(&pp, 160, 120, 8));
+	pp.grid_frame = PLAN_GRID_FRAME;
 	/* --sampler jitter: grid renders from scale 4, and no scale 2 */
 	pp.grid = PLAN_GRID_ONLY;
 	assert_true(plan_grid_scale(&pp, 8, 6, 4));
