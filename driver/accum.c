@@ -313,10 +313,23 @@ static double quad_twist(double q[4][3], const double mean[3])
  * mean's is d2 - vb, and the merged mean's (na^2 (d2 - vb) + nb^2 vb) /
  * (na + nb)^2: the diff is that where it is smaller.
  *
+ * Only onto fewer than STRAT_OLD_MAX samples: onto more, stratified
+ * themselves, d2 is no longer mostly the old mean's, and the twist of the
+ * new samples' quadrants understates their error where the sub-pixels of
+ * one render share a pattern (POV-Ray's area-light and blur sampling), so
+ * the lowered diff put the estimate of long runs at a third to a half of
+ * the truth.  At 160x120, every fold lowered against only those onto the
+ * base pass's sample (2026-12-01, one run each, estimated over true
+ * relMSE): soft_shadows --budget 4 0.47 against 1.20, thin_geometry
+ * --target 3e-4 0.53 against 0.74, --budget 4 0.59 against 0.74,
+ * starfield --target 3e-4 0.83 against 1.00, glossy_reflection --target
+ * 3e-4 0.66 against 0.86 (README).
+ *
  * A region's merge notes each pixel it folds (strat_note()), and once all
  * have folded strat_end() lowers their diffs.  Without the memory
  * (strat_begin() returns 0) the diffs stay the independent samples'.
  */
+#define STRAT_OLD_MAX 4.0
 struct strat {
 	int x0, y0, rw, rh;
 	double *tw;		/* the twist of the new samples, NaN where none */
@@ -370,7 +383,8 @@ static void strat_end(struct strat *st, struct image *acc)
 			const size_t k = (size_t)y * st->rw + x;
 			float *o = acc->px + ((size_t)(st->y0 + y) * acc->w + st->x0 + x) * ACC_NCH;
 			const double na = st->na[k], nb = st->nb[k], d2 = st->d2[k];
-			if (!isfinite(st->tw[k]) || !(na > 0.0) || !(nb > 0.0) || !isfinite(o[ACC_DIFF]))
+			if (!isfinite(st->tw[k]) || !(na > 0.0) || na >= STRAT_OLD_MAX || !(nb > 0.0) ||
+			    !isfinite(o[ACC_DIFF]))
 				continue;
 			double sum = 0.0;
 			int n = 0;

@@ -380,18 +380,23 @@ static void test_merge_grid(void **state)
  * independent figure, and so does its neighbour, whose 3 x 3 mean takes a
  * third of the twist (weighed by nb^2 it outweighs d2).  Grid renders (scale 4, 5 samples a
  * sub-pixel) and resolution scaling (scale 2, one sample a quadrant) alike.
+ * Onto 4 samples every pixel keeps the independent figure.
  */
 static void test_merge_stratified(void **state)
 {
 	const int W = 5, H = 1;
 	(void)state;
-	for (int kind = 0; kind < 2; kind++) {
-		const int s = kind ? 2 : 4;
-		const double nb = kind ? 4.0 : 20.0, nt = nb + 1.0;
+	for (int kind = 0; kind < 4; kind++) {
+		const int s = kind % 2 ? 2 : 4;
+		/* kinds 2 and 3: onto 4 samples, where the difference is no
+		 * longer mostly the old mean's */
+		const double nb = kind % 2 ? 4.0 : 20.0, na = kind < 2 ? 1.0 : 4.0, nt = nb + na;
 		struct image acc, r;
 		char err[256];
 		long folded = -1;
 		make_acc(&acc, W, H, flat_value);
+		for (int x = 0; x < W; x++)
+			accpx(&acc, (size_t)x)[ACC_SAMPLES] = (float)na;
 		assert_int_equal(image_init(&r, 2 * W, 2 * H, 3, rgb_names, err, sizeof(err)), 0);
 		for (int x = 0; x < W; x++)
 			for (int j = 0; j < 2; j++)
@@ -406,12 +411,12 @@ static void test_merge_stratified(void **state)
 		assert_int_equal(folded, W);
 		for (int x = 0; x < W; x++) {
 			const float *o = accpx(&acc, (size_t)x);
-			double mt = (0.5 + nb * 0.3) / nt, d2 = 0.04 / (mt * mt + 0.01);
-			double iid = d2 * nb / (nt * nt), own = d2 / (nt * nt);
+			double mt = (na * 0.5 + nb * 0.3) / nt, d2 = 0.04 / (mt * mt + 0.01);
+			double iid = d2 * na * nb / (nt * nt), own = d2 * na * na / (nt * nt);
 			char what[64];
-			snprintf(what, sizeof(what), "scale %d pixel %d diff", s, x);
+			snprintf(what, sizeof(what), "scale %d onto %g: pixel %d diff", s, na, x);
 			/* the twisted pixel's mean is 0.3 too */
-			assert_close(o[ACC_DIFF], x < W - 2 ? own : iid, 1e-4, 0.0, what);
+			assert_close(o[ACC_DIFF], x < W - 2 && na < 2.0 ? own : iid, 1e-4, 0.0, what);
 		}
 		image_release(&r);
 		image_release(&acc);
