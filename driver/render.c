@@ -1096,7 +1096,8 @@ static int word_at(const char *t, size_t i, const char *w)
 
 /*
  * Whether the scene file (not what it includes) names both of focal blur's
- * camera keywords, aperture and blur_samples, outside comments.  There
+ * camera keywords, aperture (but for "aperture 0") and blur_samples,
+ * outside comments and strings.  There
  * POV-Ray's antialiasing converges far more slowly than resolution scaling:
  * each antialiasing sub-sample traces its own blur samples, whose sub-pixel
  * offsets come from a table indexed by the position (tracepixel.cpp), so
@@ -1128,8 +1129,12 @@ static int scene_focal_blur(const char *path)
 				i++;
 			if (t[i + 1])
 				i++;
+		} else if (word_at(t, i, "aperture")) {
+			/* "aperture 0" is a camera without focal blur */
+			char *end;
+			double v = strtod(t + i + strlen("aperture"), &end);
+			ap |= end == t + i + strlen("aperture") || v != 0.0;
 		} else {
-			ap |= word_at(t, i, "aperture");
 			bs |= word_at(t, i, "blur_samples");
 		}
 	}

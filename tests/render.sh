@@ -297,7 +297,7 @@ fi
 # draws its blur offsets from a position-keyed table), so auto keeps scaling
 # up to 8 Mpixel frames there: at 320x240 scale 4 (1280x960) is four times
 # the width rather than a grid render at twice it.  The keywords count only
-# outside comments and strings.
+# outside comments and strings, and "aperture 0" not at all.
 cat >"$T/focal.pov" <<'EOF'
 #version 3.7;
 global_settings { assumed_gamma 1.0 }
@@ -307,7 +307,7 @@ light_source { <2, 4, -3> rgb 1 }
 plane { y, 0 pigment { checker rgb 0.1 rgb 0.9 } }
 sphere { <0, 0.5, 0>, 0.5 pigment { rgb <1, 0.3, 0.2> } }
 EOF
-sed 's|^\taperture.*|\t// aperture 0.4 blur_samples 2\n\t/* aperture */ #debug "blur_samples" }|' \
+sed 's|^\taperture.*|\taperture 0 blur_samples 2 // aperture 0.4\n\t/* aperture */ #debug "aperture 1" }|' \
 	"$T/focal.pov" >"$T/nofocal.pov"
 "$PP" render "$T/focal.pov" -o "$T/focal.exr" -W 320 -H 240 --target 2e-3 --max-passes 2 -q \
 	--keep-workdir --report "$T/focal.json" -- +WT1 || bad "focal blur: render failed"
@@ -319,7 +319,7 @@ for f in nofocal:"$T/nofocal.pov" bundled:"$SC/focal_blur.pov"; do
 	"$PP" render "${f#*:}" -o "$T/${f%%:*}.exr" -W 40 -H 30 --max-passes 0 -q \
 		--report "$T/${f%%:*}.json" -- +WT1 || bad "focal blur (${f%%:*}): render failed"
 done
-check "focal blur: keywords only in comments and strings are not focal blur" \
+check "focal blur: 'aperture 0', or aperture in comments and strings, is not focal blur" \
 	grep -q '"focal_blur": false' "$T/nofocal.json"
 check "focal blur: scenes/focal_blur.pov has it" grep -q '"focal_blur": true' "$T/bundled.json"
 "$PP" render "$SC/focal_blur.pov" -o "$T/fb-grid.exr" -W 40 -H 30 --max-passes 0 -q --sampler grid \
