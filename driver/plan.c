@@ -174,9 +174,27 @@ static int by_score(const void *a, const void *b)
 	return x->i < y->i ? -1 : x->i > y->i;	/* stable: the same plan every run */
 }
 
+/* plan_grid_scale() for an image of px pixels. */
+static int grid_at(const struct plan_params *p, int s, double px)
+{
+	return s >= 4 && (p->grid == PLAN_GRID_ALWAYS || p->grid == PLAN_GRID_ONLY ||
+			  (p->grid == PLAN_GRID_LARGE && (double)s * s * px > p->grid_frame));
+}
+
+/* A render's fixed cost at scale s: the invocation and, with cost_frame,
+ * its frame. */
+static double job_cost(const struct plan_params *p, int s)
+{
+	if (!(p->cost_frame > 0.0))
+		return p->cost_job;
+	return p->cost_job +
+	       p->cost_frame * p->frame_px * (grid_at(p, s, p->frame_px) ? 4.0 : (double)s * s);
+}
+
 static double rect_cost(const struct plan_params *p, const struct plan_region *r)
 {
-	return p->cost_job + p->cost_sample * (double)plan_region_area(r) * r->scale * r->scale;
+	return job_cost(p, r->scale) +
+	       p->cost_sample * (double)plan_region_area(r) * r->scale * r->scale;
 }
 
 static void bbox(const struct plan_region *a, const struct plan_region *b,
@@ -363,8 +381,7 @@ int plan_grid_parse(const char *name)
 
 int plan_grid_scale(const struct plan_params *p, int w, int h, int s)
 {
-	return s >= 4 && (p->grid == PLAN_GRID_ALWAYS || p->grid == PLAN_GRID_ONLY ||
-			  (p->grid == PLAN_GRID_LARGE && (double)s * s * w * h > p->grid_frame));
+	return grid_at(p, s, (double)w * h);
 }
 
 /* The first scale past cur that pixel i may be refined at: unused, and
@@ -489,7 +506,8 @@ static int split_regions(const struct plan_params *p, struct plan *out, const un
 				d = k;
 		struct plan_region a = out->regions[d], b = a;
 		int rw = a.x1 - a.x0 + 1, rh = a.y1 - a.y0 + 1;
-		if (a.cost <= total / p->min_split || a.cost - p->cost_job < 4.0 * p->cost_job ||
+		const double jc = job_cost(p, a.scale);
+		if (a.cost <= total / p->min_split || a.cost - jc < 4.0 * jc ||
 		    (rw < 2 && rh < 2))
 			break;
 		if (rh >= rw) {
@@ -507,7 +525,7 @@ static int split_regions(const struct plan_params *p, struct plan *out, const un
 		out->regions = q;
 		out->regions[d] = a;
 		out->regions[out->nregions++] = b;
-		total += p->cost_job;
+		total += jc;
 	}
 	return 0;
 }
@@ -670,10 +688,13 @@ int plan_make(const struct image *acc, const float *press, const float *fit,
 	return rc;
 }
 
-int plan_make_from(const struct image *acc, const double *e, const struct plan_params *p,
+int plan_make_from(const struct image *acc, const double *e, const struct plan_params *params,
 		   struct plan *out, char *err, size_t errlen)
 {
 	const int w = acc->w, h = acc->h;
+	struct plan_params pc = *params;
+	pc.frame_px = (double)w * h;
+	const struct plan_params *p = &pc;
 	const size_t npx = (size_t)w * h;
 	double *gain = NULL;
 	struct cand *cand = NULL;

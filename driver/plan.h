@@ -44,6 +44,12 @@ struct plan_params {
 	double grid_frame;	/* under PLAN_GRID_LARGE, the scaled frame, in
 				 * pixels, past which a scale is a grid render
 				 * (default PLAN_GRID_FRAME) */
+	double cost_frame;	/* cost of a render's frame, seconds a pixel of
+				 * it (s W x s H; a grid render's 2 W x 2 H),
+				 * whatever the region: POV-Ray allocates and
+				 * writes it whole (default 0) */
+	double frame_px;	/* the image's pixels, W x H: plan_make_from()
+				 * sets it for cost_frame */
 	double fill;		/* when the pixels at their next scales leave
 				 * the goal unmet and cost less than this, take
 				 * chosen pixels on to later scales until the

@@ -1004,6 +1004,19 @@ static void test_plan_make(void **state)
 	check_regions(&pl, &p);
 	plan_release(&pl);
 
+	/* ... and one again when the frame is dear: every render pays for its
+	 * whole s W x s H frame (here scale 2's), whatever its region */
+	p.cost_frame = 1e-3;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	assert_int_equal(pl.nregions, 1);
+	check_regions(&pl, &p);
+	const struct plan_region *g = &pl.regions[0];
+	assert_close(g->cost, p.cost_frame * PW * PH * 4.0 +
+			      p.cost_sample * 4.0 * (double)plan_region_area(g), 1e-9, 0.0,
+		     "a render's cost with its frame's");
+	plan_release(&pl);
+	p.cost_frame = 0.0;
+
 	/* ... and a cap of one region forces the merge */
 	p.max_regions = 1;
 	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
