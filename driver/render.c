@@ -110,8 +110,9 @@ static const char usage_options[] =
 	"                        holding half of it, as at highlights, scale 2 as\n"
 	"                        one render at twice the size\n"
 	"                        with POV-Ray's +AM2 +A0.1 +R3 +J; where it is spread\n"
-	"                        and the frame at scale 4 costs less than the cores\n"
-	"                        wait on POV-Ray's latency in a pass, as jitter), grid\n"
+	"                        and the frame at scale 4 costs less than twice the\n"
+	"                        cores' wait on POV-Ray's latency in a pass, as\n"
+	"                        jitter), grid\n"
 	"                        (scales 4, 8 and 16 as renders at twice the size with\n"
 	"                        POV-Ray's +AM1 +A0.0 +R(scale/2) +J0.75: scale x\n"
 	"                        scale jittered samples), scale (resolution scaling\n";
@@ -1478,8 +1479,8 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
  * jittered (PLAN_GRID_ONLY, as --sampler jitter), for the rest of the run:
  * at the first refinement pass, where the error is spread (not
  * plan_sparse_error()), the scene has no radiosity, and the whole frame
- * at scale 4, 16 samples a pixel, costs less than the cores wait on
- * POV-Ray's latency in a pass.  There a pass saved is worth more than the
+ * at scale 4, 16 samples a pixel, costs less than JITTER_WAITS times the
+ * cores' wait on POV-Ray's latency in a pass.  There a pass saved is worth more than the
  * pixels scale 2 would spare, and no regular grid of scale 2 aliases into
  * the mean: on soft_shadows at 160x120 (2026-11-22, one run each) target
  * 3e-3 reached relMSE 2.1e-4 in 0.58 CPU s, against 3.1e-4 in 0.72-0.81 s by
@@ -1489,13 +1490,22 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
  * scale 4, 0.8 s of latency on the cores; media 2.3 to 4.7 s) the small step of
  * scale 2 lets the loop stop sooner or share a budget over more pixels:
  * forced there, --budget 2 erred 2.0 (glossy_reflection) and 4.4 (media)
- * times as much.
+ * times as much.  "Less than" is JITTER_WAITS times the wait: POV-Ray's
+ * latency is wall time, the same on a slower machine, where the samples
+ * cost more.  On a machine about half as fast as the sweep's, soft_shadows'
+ * frame at scale 4 cost 1.17 CPU s for 0.62 s of latency on the cores, the
+ * run took scale 2, and at --target 3e-3 stopped at relMSE 5.9e-3 on an
+ * estimate of 2.5e-3 (the horizon in the top tenth of a pixel row, below
+ * scale 2's regular grid, holding 4.9e-3 of it), where jittered it reached
+ * 2.1e-4 in 1.3 CPU s; glossy_reflection's frame (2.3 CPU s on the sweep's
+ * machine) and media's stay above it.
  */
+#define JITTER_WAITS 2.0
 static int one_step(const struct run *r, int *sparse)
 {
 	const double frame4 = 16.0 * r->cost_sample * (double)r->w * r->h;
 	return r->grid == PLAN_GRID_LARGE && r->npasses == 1 && !r->radiosity && !r->focal &&
-	       frame4 < r->latency * r->cores && !sparse_error(r, sparse);
+	       frame4 < JITTER_WAITS * r->latency * r->cores && !sparse_error(r, sparse);
 }
 
 /*
@@ -1610,7 +1620,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	}
 	if (choose) {	/* made once a pass runs on it */
 		r->jittered = 1;
-		progress(r, "pass %d: the frame at scale 4 costs less than the cores wait on "
+		progress(r, "pass %d: the frame at scale 4 costs less than twice the cores' wait on "
 			 "POV-Ray's latency: no scale 2, scale 4 and up jittered", pass);
 	}
 	if (pre_idx) {

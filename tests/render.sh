@@ -371,7 +371,7 @@ else
 	bad "starfield: reference render failed"
 fi
 # where the error is spread, auto goes straight to scale 4, jittered, when the
-# frame at scale 4 costs less than the cores wait on POV-Ray's latency (samples
+# frame at scale 4 costs less than twice the cores' wait on POV-Ray's latency (samples
 # taken as free here), and by scale 2 otherwise (samples taken as dear)
 for c in free dear; do
 	cs=1e-9
