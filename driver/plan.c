@@ -181,19 +181,18 @@ static int grid_at(const struct plan_params *p, int s, double px)
 			  (p->grid == PLAN_GRID_LARGE && (double)s * s * px > p->grid_frame));
 }
 
-/* A render's fixed cost at scale s: the invocation and, with cost_frame,
- * its frame. */
-static double job_cost(const struct plan_params *p, int s)
+/* A render's fixed cost at scale s in an image of px pixels: the
+ * invocation and, with cost_frame, its frame. */
+static double job_cost(const struct plan_params *p, int s, double px)
 {
 	if (!(p->cost_frame > 0.0))
 		return p->cost_job;
-	return p->cost_job +
-	       p->cost_frame * p->frame_px * (grid_at(p, s, p->frame_px) ? 4.0 : (double)s * s);
+	return p->cost_job + p->cost_frame * px * (grid_at(p, s, px) ? 4.0 : (double)s * s);
 }
 
-static double rect_cost(const struct plan_params *p, const struct plan_region *r)
+static double rect_cost(const struct plan_params *p, const struct plan_region *r, double px)
 {
-	return job_cost(p, r->scale) +
+	return job_cost(p, r->scale, px) +
 	       p->cost_sample * (double)plan_region_area(r) * r->scale * r->scale;
 }
 
@@ -237,6 +236,7 @@ static int pack(const struct plan_params *p, int w, int h, int s, const unsigned
 		const double *gain, int tile, int cap, struct plan_region **rs, size_t *nrs)
 {
 	int tw = (w + tile - 1) / tile, th = (h + tile - 1) / tile;
+	const double px = (double)w * h;
 	struct plan_region *r = NULL;
 	size_t n = 0, alloc = 0;
 	int ret = -1;
@@ -321,7 +321,7 @@ static int pack(const struct plan_params *p, int w, int h, int s, const unsigned
 			for (size_t b = a + 1; b < n; b++) {
 				struct plan_region m;
 				bbox(&r[a], &r[b], &m);
-				double d = rect_cost(p, &m) - rect_cost(p, &r[a]) - rect_cost(p, &r[b]);
+				double d = rect_cost(p, &m, px) - rect_cost(p, &r[a], px) - rect_cost(p, &r[b], px);
 				if (d < best) {
 					best = d;
 					ba = a;
@@ -347,7 +347,7 @@ static int pack(const struct plan_params *p, int w, int h, int s, const unsigned
 		}
 	}
 	for (size_t k = 0; k < n; k++)
-		r[k].cost = rect_cost(p, &r[k]);
+		r[k].cost = rect_cost(p, &r[k], px);
 	if (n) {
 		void *q = realloc(*rs, (*nrs + n) * sizeof(**rs));
 		if (!q)
@@ -466,9 +466,10 @@ static int next_upgrade(const struct plan_params *p, const struct image *acc, si
 
 /* Count region r's pixels that its scale was planned for (ps) into its
  * chosen and gain, and set its cost. */
-static void region_count(const struct plan_params *p, struct plan_region *r, int w,
-			 const unsigned char *ps, const double *gain)
+static void region_count(const struct plan_params *p, struct plan_region *r,
+			 const struct plan *out, const unsigned char *ps, const double *gain)
 {
+	const int w = out->w;
 	r->chosen = 0;
 	r->gain = 0.0;
 	for (int y = r->y0; y <= r->y1; y++)
@@ -479,7 +480,7 @@ static void region_count(const struct plan_params *p, struct plan_region *r, int
 				r->gain += gain[i];
 			}
 		}
-	r->cost = rect_cost(p, r);
+	r->cost = rect_cost(p, r, (double)w * out->h);
 }
 
 /*
@@ -506,7 +507,7 @@ static int split_regions(const struct plan_params *p, struct plan *out, const un
 				d = k;
 		struct plan_region a = out->regions[d], b = a;
 		int rw = a.x1 - a.x0 + 1, rh = a.y1 - a.y0 + 1;
-		const double jc = job_cost(p, a.scale);
+		const double jc = job_cost(p, a.scale, (double)out->w * out->h);
 		if (a.cost <= total / p->min_split || a.cost - jc < 4.0 * jc ||
 		    (rw < 2 && rh < 2))
 			break;
@@ -517,8 +518,8 @@ static int split_regions(const struct plan_params *p, struct plan *out, const un
 			a.x1 = a.x0 + rw / 2 - 1;
 			b.x0 = a.x1 + 1;
 		}
-		region_count(p, &a, out->w, ps, gain);
-		region_count(p, &b, out->w, ps, gain);
+		region_count(p, &a, out, ps, gain);
+		region_count(p, &b, out, ps, gain);
 		void *q = realloc(out->regions, (out->nregions + 1) * sizeof(*out->regions));
 		if (!q)
 			return -1;
@@ -584,7 +585,7 @@ static int fit_budget(const struct plan_params *p, struct plan *out, const unsig
 			d->r = *r;
 			d->r.y0 = y;
 			d->r.y1 = y + p->tile - 1 < r->y1 ? y + p->tile - 1 : r->y1;
-			region_count(p, &d->r, out->w, ps, gain);
+			region_count(p, &d->r, out, ps, gain);
 			d->parent = k;
 			d->seq = (size_t)q;
 			d->keep = 0;
@@ -613,7 +614,7 @@ static int fit_budget(const struct plan_params *p, struct plan *out, const unsig
 			m->y1 = b[k].r.y1;
 			m->chosen += b[k].r.chosen;
 			m->gain += b[k].r.gain;
-			m->cost = rect_cost(p, m);
+			m->cost = rect_cost(p, m, (double)out->w * out->h);
 		} else {
 			out->regions[n++] = b[k].r;
 		}
@@ -688,13 +689,10 @@ int plan_make(const struct image *acc, const float *press, const float *fit,
 	return rc;
 }
 
-int plan_make_from(const struct image *acc, const double *e, const struct plan_params *params,
+int plan_make_from(const struct image *acc, const double *e, const struct plan_params *p,
 		   struct plan *out, char *err, size_t errlen)
 {
 	const int w = acc->w, h = acc->h;
-	struct plan_params pc = *params;
-	pc.frame_px = (double)w * h;
-	const struct plan_params *p = &pc;
 	const size_t npx = (size_t)w * h;
 	double *gain = NULL;
 	struct cand *cand = NULL;

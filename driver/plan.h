@@ -48,8 +48,6 @@ struct plan_params {
 				 * it (s W x s H; a grid render's 2 W x 2 H),
 				 * whatever the region: POV-Ray allocates and
 				 * writes it whole (default 0) */
-	double frame_px;	/* the image's pixels, W x H: plan_make_from()
-				 * sets it for cost_frame */
 	double fill;		/* when the pixels at their next scales leave
 				 * the goal unmet and cost less than this, take
 				 * chosen pixels on to later scales until the
