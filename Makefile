@@ -27,7 +27,7 @@ TOOL_BIN = $(BUILD)/tests/gen_image $(BUILD)/bench/bench_analyze $(BUILD)/bench/
 
 .PHONY: all check unit e2e bench clean deps demo sweep sampler
 .SECONDARY:
-all: $(BUILD)/povpress
+all: $(BUILD)/povpress $(BUILD)/povwait.so
 
 # The Debian packages are installed (when missing) once per build tree.
 $(BUILD)/.deps: scripts/install-deps.sh
@@ -41,6 +41,16 @@ $(BUILD)/%.o: %.c | $(BUILD)/.deps
 
 $(BUILD)/povpress: $(REG_OBJ) $(DRV_OBJ)
 	$(CC) $(CFLAGS) -o $@ $^ $(EXR_LIBS) $(LDLIBS)
+
+# Preloaded into the POV-Ray processes povpress starts: cuts POV-Ray's
+# polling waits (driver/povwait/povwait.c).  povpress finds it next to itself.
+$(BUILD)/povwait.so: driver/povwait/povwait.c | $(BUILD)/.deps
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -fPIC -shared -o $@ $< -ldl
+
+# tests/render.sh's helper for povwait.so: the waits POV-Ray polls with.
+$(BUILD)/tests/povray_waits: tests/povray_waits.c | $(BUILD)/.deps
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -o $@ $< $(LDLIBS)
 
 $(BUILD)/tests/test_%: $(BUILD)/tests/test_%.o $(REG_OBJ) $(LIB_DRV_OBJ)
 	$(CC) $(CFLAGS) -o $@ $^ -lcmocka $(EXR_LIBS) $(LDLIBS)
@@ -68,7 +78,7 @@ deps: $(BUILD)/.deps
 unit: $(UNIT_BIN)
 	@set -e; for t in $(UNIT_BIN); do echo "== $$t"; $$t; done
 
-e2e: $(BUILD)/povpress $(BUILD)/tests/gen_image $(BUILD)/tools/boxdown
+e2e: $(BUILD)/povpress $(BUILD)/povwait.so $(BUILD)/tests/povray_waits $(BUILD)/tests/gen_image $(BUILD)/tools/boxdown
 	tests/e2e.sh $(BUILD)
 	tests/render.sh $(BUILD)
 
@@ -78,20 +88,20 @@ check: unit e2e
 # bundled scenes in quick mode (BENCH_ARGS="scenes/media.pov" for one scene;
 # `make sweep` is the full benchmark).
 BENCH_ARGS ?=
-bench: $(BUILD)/bench/bench_analyze $(BUILD)/bench/bench_denoise $(BUILD)/povpress \
+bench: $(BUILD)/bench/bench_analyze $(BUILD)/bench/bench_denoise $(BUILD)/povpress $(BUILD)/povwait.so \
 		$(BUILD)/tools/boxdown
 	$(BUILD)/bench/bench_analyze
 	$(BUILD)/bench/bench_denoise
 	BUILD=$(BUILD) scripts/sweep.sh --quick $(BENCH_ARGS)
 
-demo: $(BUILD)/povpress $(BUILD)/tools/boxdown
+demo: $(BUILD)/povpress $(BUILD)/povwait.so $(BUILD)/tools/boxdown
 	scripts/demo.sh $(BUILD)
 
-sweep: $(BUILD)/povpress $(BUILD)/tools/boxdown
+sweep: $(BUILD)/povpress $(BUILD)/povwait.so $(BUILD)/tools/boxdown
 	BUILD=$(BUILD) scripts/sweep.sh $(SWEEP_ARGS)
 
 # How a region gets more samples: +AM2 against resolution scaling, measured.
-sampler: $(BUILD)/povpress $(BUILD)/tools/boxdown
+sampler: $(BUILD)/povpress $(BUILD)/povwait.so $(BUILD)/tools/boxdown
 	scripts/sampler.sh $(BUILD)
 
 clean:

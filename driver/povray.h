@@ -285,6 +285,11 @@ void pov_pool_opts_init(struct pov_pool_opts *opts);
 /* CPUs this process may run on (its affinity mask), at least 1. */
 int pov_cpu_count(void);
 
+/* The library every POV-Ray process is started with preloaded (povwait.so
+ * next to the povpress executable, or $POVPRESS_POVWAIT; "0" or empty for
+ * none), or NULL when there is none.  It cuts POV-Ray's polling waits. */
+const char *pov_wait_library(void);
+
 /*
  * Choose the number of concurrent jobs (*jobs_out) and POV-Ray threads per
  * job (*threads_out, for +WT) for njobs jobs on cores CPUs: jobs =

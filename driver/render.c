@@ -110,9 +110,8 @@ static const char usage_options[] =
 	"                        holding half of it, as at highlights, scale 2 as\n"
 	"                        one render at twice the size\n"
 	"                        with POV-Ray's +AM2 +A0.1 +R3 +J; where it is spread\n"
-	"                        and the frame at scale 4 costs less than twice the\n"
-	"                        cores' wait on POV-Ray's latency in a pass, as\n"
-	"                        jitter), grid\n"
+	"                        and the frame at scale 4 takes less than 0.7 s on\n"
+	"                        the cores, as jitter), grid\n"
 	"                        (scales 4, 8 and 16 as renders at twice the size with\n"
 	"                        POV-Ray's +AM1 +A0.0 +R(scale/2) +J0.75: scale x\n"
 	"                        scale jittered samples), scale (resolution scaling\n";
@@ -683,11 +682,12 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 	json_str(f, r->stop ? r->stop : "");
 	fprintf(f, ",\n  \"cost_model\": {\"job_s\": %.17g, \"sample_s\": %.17g, "
 		"\"latency_s\": %.6g, \"scale\": %.4g},\n  \"radiosity\": %s,\n"
-		"  \"radiosity_scale\": %d,\n  \"focal_blur\": %s,\n"
+		"  \"radiosity_scale\": %d,\n  \"focal_blur\": %s,\n  \"povwait\": %s,\n"
 		"  \"sampler\": \"%s\",\n  \"sampler_chosen\": \"%s\",\n  \"prelaunch\": \"%s\",\n"
 		"  \"final\": \"%s\",\n  \"passes\": [\n",
 		r->cost_job, r->cost_sample, r->latency, cost_scale(r), r->radiosity ? "true" : "false",
-		r->rad_scale, r->focal ? "true" : "false", r->aa ? "aa" : plan_grid_name(r->grid),
+		r->rad_scale, r->focal ? "true" : "false", pov_wait_library() ? "true" : "false",
+		r->aa ? "aa" : plan_grid_name(r->grid),
 		r->aa ? "aa" : plan_grid_name(run_grid(r)),
 		prelaunch_names[r->prelaunch],
 		r->final == ACC_FINAL_AUTO && !r->filter ? "blend" : final_names[r->final]);
@@ -1391,8 +1391,9 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	}
 	if (r->verbose)
 		fprintf(stderr, "povpress render: base pass %.2f s wall, %.2f s CPU; cost model: "
-			"%.3g s per sample, %.3g s per invocation (latency %.2f s)%s\n",
+			"%.3g s per sample, %.3g s per invocation (latency %.2f s%s)%s\n",
 			p.wall_s, p.cpu_s, r->cost_sample, r->cost_job, r->latency,
+			pov_wait_library() ? ", waits cut by povwait.so" : "",
 			r->radiosity ? "; radiosity saved for the region renders" : "");
 	ret = 0;
 out:
@@ -1479,33 +1480,33 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
  * jittered (PLAN_GRID_ONLY, as --sampler jitter), for the rest of the run:
  * at the first refinement pass, where the error is spread (not
  * plan_sparse_error()), the scene has no radiosity, and the whole frame
- * at scale 4, 16 samples a pixel, costs less than JITTER_WAITS times the
- * cores' wait on POV-Ray's latency in a pass.  There a pass saved is worth more than the
- * pixels scale 2 would spare, and no regular grid of scale 2 aliases into
- * the mean: on soft_shadows at 160x120 (2026-11-22, one run each) target
- * 3e-3 reached relMSE 2.1e-4 in 0.58 CPU s, against 3.1e-4 in 0.72-0.81 s by
- * scale 2 then 4, whose regular grids alias on the far checkerboard and
- * whose difference at the horizon put the estimate at 7 times the true
- * error.  Where samples are dear (focal_blur: 1.2 CPU s for the frame at
- * scale 4, 0.8 s of latency on the cores; media 2.3 to 4.7 s) the small step of
+ * at scale 4, 16 samples a pixel, takes less than JITTER_FRAME_S on the
+ * cores.  There jittering every pixel is cheap, and no regular grid of
+ * scale 2 aliases into the mean or hides an edge from the estimate: on
+ * soft_shadows at 160x120 (2026-11-22, one run each) target 3e-3 reached
+ * relMSE 2.1e-4 in 0.58 CPU s, against 3.1e-4 in 0.72-0.81 s by scale 2
+ * then 4, whose regular grids alias on the far checkerboard and whose
+ * difference at the horizon put the estimate at 7 times the true error;
+ * and by scale 2 it can stop early: at --target 3e-3 at relMSE 5.9e-3 on an
+ * estimate of 2.5e-3 (2026-12-01, the horizon in the top tenth of a pixel
+ * row, below scale 2's grid, holding 4.9e-3 of it), where jittered it
+ * reached 2.1e-4 to 3e-4 in 1.2 to 1.3 CPU s.  Where samples are dear
+ * (focal_blur: 1.2 CPU s for the frame at scale 4 on the faster machine of
+ * 2026-12-01; glossy_reflection 2.3 s, media 2.3 to 4.7 s) the small step of
  * scale 2 lets the loop stop sooner or share a budget over more pixels:
  * forced there, --budget 2 erred 2.0 (glossy_reflection) and 4.4 (media)
- * times as much.  "Less than" is JITTER_WAITS times the wait: POV-Ray's
- * latency is wall time, the same on a slower machine, where the samples
- * cost more.  On a machine about half as fast as the sweep's, soft_shadows'
- * frame at scale 4 cost 1.17 CPU s for 0.62 s of latency on the cores, the
- * run took scale 2, and at --target 3e-3 stopped at relMSE 5.9e-3 on an
- * estimate of 2.5e-3 (the horizon in the top tenth of a pixel row, below
- * scale 2's regular grid, holding 4.9e-3 of it), where jittered it reached
- * 2.1e-4 in 1.3 CPU s; glossy_reflection's frame (2.3 CPU s on the sweep's
- * machine) and media's stay above it.
+ * times as much.  The rule was once the frame against twice the cores'
+ * wait on POV-Ray's latency in a pass, 0.3 to 0.36 s on both machines
+ * measured (0.6 to 0.7 s a core); povwait.so cut that wait to 0.01 to 0.03
+ * s, and the scale-2 path came back with its early stop, so the frame is
+ * now held to the time the wait stood for.
  */
-#define JITTER_WAITS 2.0
+#define JITTER_FRAME_S 0.7
 static int one_step(const struct run *r, int *sparse)
 {
 	const double frame4 = 16.0 * r->cost_sample * (double)r->w * r->h;
 	return r->grid == PLAN_GRID_LARGE && r->npasses == 1 && !r->radiosity && !r->focal &&
-	       frame4 < JITTER_WAITS * r->latency * r->cores && !sparse_error(r, sparse);
+	       frame4 < JITTER_FRAME_S * r->cores && !sparse_error(r, sparse);
 }
 
 /*
@@ -1621,8 +1622,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	}
 	if (choose) {	/* made once a pass runs on it */
 		r->jittered = 1;
-		progress(r, "pass %d: the frame at scale 4 costs less than twice the cores' wait on "
-			 "POV-Ray's latency: no scale 2, scale 4 and up jittered", pass);
+		progress(r, "pass %d: the frame at scale 4 takes less than %.1f s on the cores: "
+			 "no scale 2, scale 4 and up jittered", pass, JITTER_FRAME_S);
 	}
 	if (pre_idx) {
 		pre = r->pre;
