@@ -66,15 +66,23 @@ static void set_fn(void *fn, size_t size, void *sym)
 	memcpy(fn, &sym, size);
 }
 
-__attribute__((constructor)) static void povwait_init(void)
+/* The real functions, looked up once; before our constructor has run (a
+ * wait in another library's constructor) on first use. */
+static void resolve(void)
 {
-	const char *name = program_invocation_short_name;
 	void *ver = dlvsym(RTLD_NEXT, "pthread_cond_timedwait", "GLIBC_2.3.2");
 
 	set_fn(&real_sleep, sizeof(real_sleep), dlsym(RTLD_NEXT, "clock_nanosleep"));
 	set_fn(&real_timedwait, sizeof(real_timedwait),
 	       ver ? ver : dlsym(RTLD_NEXT, "pthread_cond_timedwait"));
 	set_fn(&real_clockwait, sizeof(real_clockwait), dlsym(RTLD_NEXT, "pthread_cond_clockwait"));
+}
+
+__attribute__((constructor)) static void povwait_init(void)
+{
+	const char *name = program_invocation_short_name;
+
+	resolve();
 	/* povray, povray3.7, povray.bin, ... */
 	active = name && strncmp(name, "povray", 6) == 0;
 }
@@ -97,6 +105,8 @@ int clock_nanosleep(clockid_t c, int flags, const struct timespec *req, struct t
 {
 	struct timespec r;
 
+	if (!real_sleep)
+		resolve();
 	if (!real_sleep)
 		return ENOSYS;
 	if (!req || req->tv_nsec < 0 || req->tv_nsec >= NS)
@@ -122,6 +132,8 @@ int pthread_cond_timedwait(pthread_cond_t *cv, pthread_mutex_t *m, const struct 
 	long long left;
 
 	if (!real_timedwait)
+		resolve();
+	if (!real_timedwait)
 		return ENOSYS;
 	if (!active || abst->tv_nsec < 0 || abst->tv_nsec >= NS)
 		return real_timedwait(cv, m, abst);
@@ -137,6 +149,8 @@ int pthread_cond_clockwait(pthread_cond_t *cv, pthread_mutex_t *m, clockid_t c,
 {
 	struct timespec d;
 
+	if (!real_clockwait)
+		resolve();
 	if (!real_clockwait)
 		return ENOSYS;
 	if (!active || abst->tv_nsec < 0 || abst->tv_nsec >= NS)
