@@ -69,7 +69,8 @@ static const char usage_options[] =
 	"  --budget SECONDS      wall-clock seconds to stop within (default: none;\n"
 	"                        region renders still running when only the time\n"
 	"                        to merge, analyse and write the final image is\n"
-	"                        left are stopped)\n"
+	"                        left are stopped; a base pass still running at its\n"
+	"                        end is stopped and the run fails, with no image)\n"
 	"  --max-passes N        refinement passes after the base pass (default 8)\n"
 	"  --prelaunch auto|on|off\n"
 	"                        start each pass's likely region renders during the\n"
@@ -752,9 +753,30 @@ static void frame_job(const struct run *r, int k, int threads, const char *out,
  * base pass and the radiosity pass.  what names it in messages.  Returns 0,
  * -1 on failure (err says why), POV_INTERRUPTED.
  */
+/* How far POV-Ray's console log says the render got: " (POV-Ray had
+ * rendered N of M pixels)", or "" when it shows no progress line (POV-Ray
+ * prints them with its status stream on). */
+static void render_progress(const char *log, char *buf, size_t len)
+{
+	long n = -1, m = -1;
+	for (const char *p = log; p && (p = strstr(p, "Rendered ")); p++) {
+		long a, b;
+		if (sscanf(p, "Rendered %ld of %ld pixels", &a, &b) == 2) {
+			n = a;
+			m = b;
+		}
+	}
+	if (n >= 0)
+		snprintf(buf, len, " (POV-Ray had rendered %ld of %ld pixels)", n, m);
+	else
+		buf[0] = '\0';
+}
+
+/* Render the whole frame at scale k into out.  deadline: seconds from now
+ * to stop POV-Ray at (0: none); a render stopped there is an error. */
 static int whole_frame(struct run *r, int k, int threads, const char *out,
-		       const char *radfile, const char *what, struct pov_result *res, char *err,
-		       size_t errlen)
+		       const char *radfile, const char *what, double deadline,
+		       struct pov_result *res, char *err, size_t errlen)
 {
 	const char **extra = calloc(r->nextra + 8, sizeof(char *));
 	if (!extra) {
@@ -771,6 +793,7 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
 	 * pass's) */
 	po.prelaunched = rad_prelaunched(r, k) ? r->pre : NULL;
 	po.timeout_s = r->timeout > 0 ? r->timeout : 0.0;
+	po.deadline_s = deadline;
 	double written = 0.0;
 	po.ready = note_written;
 	po.ready_log = stats_printed;
@@ -786,6 +809,15 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
 	}
 	if (rc)
 		return -1;
+	if (res->status == POV_CANCELLED && deadline > 0.0) {
+		char got[96];
+		render_progress(res->log, got, sizeof got);
+		errbuf_printf(err, errlen, "the %s of '%s' (%dx%d) did not finish within the "
+			      "budget of %g s%s: there is no image to refine; give a larger "
+			      "--budget or a smaller -W/-H", what, r->scene, r->w * k, r->h * k,
+			      r->budget, got);
+		return -1;
+	}
 	if (res->status != POV_OK) {
 		errbuf_printf(err, errlen, "the %s of '%s' (%dx%d) failed: %s", what, r->scene,
 			      r->w * k, r->h * k, res->message);
@@ -885,7 +917,7 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	/* one thread: on several POV-Ray computes another solution every run,
 	 * some much worse (radiosity_room at 640x480: relMSE 0.8e-3 to 2.6e-3
 	 * in three runs on two threads, 1.0e-3 on one; the same script) */
-	int ret = whole_frame(r, k, 1, out, rad, "radiosity pass", &res, err, errlen);
+	int ret = whole_frame(r, k, 1, out, rad, "radiosity pass", 0.0, &res, err, errlen);
 	if (ret)
 		goto out;
 	ret = -1;
@@ -1311,7 +1343,15 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	prelaunch_first(r);
 	/* one sample at each pixel centre; radiosity, if the scene has any, is
 	 * saved for the region renders */
-	int ret = whole_frame(r, 1, r->cores, out, r->radfile, "base pass", &res, err, errlen);
+	/* Under a budget the base pass is stopped at its end: POV-Ray writes no
+	 * image when stopped, and with no base pass there is nothing to refine
+	 * (a scene whose base pass takes minutes, given --budget 20, would
+	 * otherwise run for minutes) */
+	double left = r->budget > 0.0 ? r->budget - elapsed(r) : 0.0;
+	if (r->budget > 0.0 && left < 0.01)
+		left = 0.01;
+	int ret = whole_frame(r, 1, r->cores, out, r->radfile, "base pass", left, &res, err,
+			      errlen);
 	if (ret)
 		goto out;
 	ret = -1;

@@ -577,6 +577,21 @@ check "... and it ends within the 4 s budget ($dt s)" num 'a <= 4.3' "$dt"
 check "... the output is a complete image" valid_exr "$T/dl.exr"
 check "... no POV-Ray child left" no_povray_left "$T/dl work"
 
+# a base pass longer than the budget (media at 1280x960: about 12 s on two
+# cores here) is stopped at the budget's end: an error naming the budget,
+# no image, nothing left running
+t0=$EPOCHREALTIME
+"$PP" render "$SC/media.pov" -o "$T/bb.exr" -W 1280 -H 960 --budget 1 --workdir "$T/bb work" \
+	2>"$T/bb.err"
+rc=$?
+dt=$(awk -v a="$t0" -v b="$EPOCHREALTIME" 'BEGIN { printf "%.2f", b - a }')
+check "base pass past the budget: the run fails" test $rc -ne 0
+check "... saying so: $(head -c 150 "$T/bb.err")" \
+	grep -q "base pass .* did not finish within the budget of 1 s" "$T/bb.err"
+check "... stopped at the budget's end, not the pass's ($dt s)" num 'a <= 2.5' "$dt"
+check "... no output file" test ! -e "$T/bb.exr"
+check "... no POV-Ray child left" no_povray_left "$T/bb work"
+
 # --- --prelaunch: renders started a pass early, taken or stopped -----------
 for m in auto off; do
 	"$PP" render "$SC/soft_shadows.pov" -o "$T/pl-$m.exr" -W $W -H $H --budget 3 \
