@@ -301,9 +301,8 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			 * its own 2 x 2 render pixels show, if less (hdr_highlights
 			 * at 160x120, --budget 2: the estimate 10.7 and 11.1 times
 			 * the true relMSE with the difference, 1.7 and 3.4 with
-			 * the spread; at targets 3e-3 to 1e-4 the same, at 4 s 0.39
-			 * against 0.43, at 8 s 0.79 against 0.42; starfield within
-			 * 0.02) */
+			 * the spread; at targets 3e-3 to 1e-4 and 8 s the same or
+			 * nearer; starfield the same) */
 			double er = d;
 			if (first && aa_pixel_var(img, oy, ch, f, x, y, v) && rel3(o, v) < d)
 				er = rel3(o, v);
