@@ -201,29 +201,6 @@ static int aa_pixel(const struct image *img, int oy, const int ch[3], int f, int
 	return ok;
 }
 
-/* The variance of pixel (x, y)'s value in an antialiased render f > 1
- * times the image's size, from the spread of its f x f render pixels (each
- * antialiased on its own: as many stratified estimates of the pixel): their
- * sample variance over f^2, into v; 0 if one is not finite. */
-static int aa_pixel_var(const struct image *img, int oy, const int ch[3], int f, int x, int y,
-			double v[3])
-{
-	double mean[3];
-	int ok = aa_pixel(img, oy, ch, f, x, y, mean);
-	for (int c = 0; c < 3; c++)
-		v[c] = 0.0;
-	for (int j = 0; j < f; j++)
-		for (int l = 0; l < f; l++) {
-			const float *p = img->px + ((size_t)(y * f + j - oy) * img->w +
-						    (size_t)x * f + l) * img->nch;
-			for (int c = 0; c < 3; c++) {
-				double d = p[ch[c]] - mean[c];
-				v[c] += d * d / ((double)(f * f - 1) * (f * f));
-			}
-		}
-	return ok;
-}
-
 /* The worth of an antialiased render of a region (worth_samples()),
  * rounded. */
 static int aa_worth(const struct image *acc, const struct image *img, int oy, const int ch[3],
@@ -291,22 +268,12 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			 * mean can hold a sample grid's aliasing): each one's
 			 * weight squared times it, or for the old mean its own
 			 * error if larger */
-			double e2[3], v[3];
+			double e2[3];
 			for (int c = 0; c < 3; c++)
 				e2[c] = (mean[c] - old[c]) * (mean[c] - old[c]);
 			double d = rel3(o, e2), wa = na / (na + k), wb = k / (na + k);
 			double em = isfinite(prev) && prev > d ? prev : d;
-			/* onto the base pass's one sample the difference is mostly
-			 * that sample's noise: the render's share is the variance
-			 * its own 2 x 2 render pixels show, if less (hdr_highlights
-			 * at 160x120, --budget 2: the estimate 10.7 and 11.1 times
-			 * the true relMSE with the difference, 1.7 and 3.4 with
-			 * the spread; at targets 3e-3 to 1e-4 and 8 s the same or
-			 * nearer; starfield the same) */
-			double er = d;
-			if (first && aa_pixel_var(img, oy, ch, f, x, y, v) && rel3(o, v) < d)
-				er = rel3(o, v);
-			acc->px[i * ACC_NCH + ACC_DIFF] = (float)(wb * wb * er + wa * wa * em);
+			acc->px[i * ACC_NCH + ACC_DIFF] = (float)(wb * wb * d + wa * wa * em);
 		}
 	return count;
 }
