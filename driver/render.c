@@ -141,6 +141,10 @@ static const char usage_options2[] =
 	"  -- OPTIONS            passed to every POV-Ray run (e.g. Declare=AreaN=4 +WT1);\n"
 	"                        antialiasing options are overridden in region renders\n"
 	"\n"
+	"Environment: POVPRESS_POVRAY, the POV-Ray binary (default: povray in PATH);\n"
+	"POVPRESS_POVWAIT, the library preloaded into POV-Ray to cut its polling\n"
+	"waits (default: povwait.so next to povpress; 0 or empty: none).\n"
+	"\n"
 	"Exit status: 0 done, 1 failure, 2 bad usage, 130 interrupted (the output then\n"
 	"holds the best image so far, or does not exist; --resume continues).\n";
 
