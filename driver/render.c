@@ -754,30 +754,10 @@ static void frame_job(const struct run *r, int k, int threads, const char *out,
 /*
  * Render the whole frame at scale k (antialiasing off, POVPRESS_PASS=0) on
  * the given threads into out, saving the radiosity data to radfile: the
- * base pass and the radiosity pass.  what names it in messages.  Returns 0,
- * -1 on failure (err says why), POV_INTERRUPTED.
+ * base pass and the radiosity pass.  what names it in messages; deadline is
+ * seconds from now to stop POV-Ray at (0: none), a render stopped there an
+ * error.  Returns 0, -1 on failure (err says why), POV_INTERRUPTED.
  */
-/* How far POV-Ray's console log says the render got: " (POV-Ray had
- * rendered N of M pixels)", or "" when it shows no progress line (POV-Ray
- * prints them with its status stream on). */
-static void render_progress(const char *log, char *buf, size_t len)
-{
-	long n = -1, m = -1;
-	for (const char *p = log; p && (p = strstr(p, "Rendered ")); p++) {
-		long a, b;
-		if (sscanf(p, "Rendered %ld of %ld pixels", &a, &b) == 2) {
-			n = a;
-			m = b;
-		}
-	}
-	if (n >= 0)
-		snprintf(buf, len, " (POV-Ray had rendered %ld of %ld pixels)", n, m);
-	else
-		buf[0] = '\0';
-}
-
-/* Render the whole frame at scale k into out.  deadline: seconds from now
- * to stop POV-Ray at (0: none); a render stopped there is an error. */
 static int whole_frame(struct run *r, int k, int threads, const char *out,
 		       const char *radfile, const char *what, double deadline,
 		       struct pov_result *res, char *err, size_t errlen)
@@ -814,12 +794,10 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
 	if (rc)
 		return -1;
 	if (res->status == POV_CANCELLED && deadline > 0.0) {
-		char got[96];
-		render_progress(res->log, got, sizeof got);
 		errbuf_printf(err, errlen, "the %s of '%s' (%dx%d) did not finish within the "
-			      "budget of %g s%s: there is no image to refine; give a larger "
+			      "budget of %g s: there is no image to refine; give a larger "
 			      "--budget or a smaller -W/-H", what, r->scene, r->w * k, r->h * k,
-			      r->budget, got);
+			      r->budget);
 		return -1;
 	}
 	if (res->status != POV_OK) {
