@@ -464,6 +464,12 @@ static int next_upgrade(const struct plan_params *p, const struct image *acc, si
 	return 1;
 }
 
+/* The pixels of the plan's image (a render's frame grows with them). */
+static double plan_px(const struct plan *out)
+{
+	return (double)out->w * out->h;
+}
+
 /* Count region r's pixels that its scale was planned for (ps) into its
  * chosen and gain, and set its cost. */
 static void region_count(const struct plan_params *p, struct plan_region *r,
@@ -480,7 +486,7 @@ static void region_count(const struct plan_params *p, struct plan_region *r,
 				r->gain += gain[i];
 			}
 		}
-	r->cost = rect_cost(p, r, (double)w * out->h);
+	r->cost = rect_cost(p, r, plan_px(out));
 }
 
 /*
@@ -507,7 +513,7 @@ static int split_regions(const struct plan_params *p, struct plan *out, const un
 				d = k;
 		struct plan_region a = out->regions[d], b = a;
 		int rw = a.x1 - a.x0 + 1, rh = a.y1 - a.y0 + 1;
-		const double jc = job_cost(p, a.scale, (double)out->w * out->h);
+		const double jc = job_cost(p, a.scale, plan_px(out));
 		if (a.cost <= total / p->min_split || a.cost - jc < 4.0 * jc ||
 		    (rw < 2 && rh < 2))
 			break;
@@ -614,7 +620,7 @@ static int fit_budget(const struct plan_params *p, struct plan *out, const unsig
 			m->y1 = b[k].r.y1;
 			m->chosen += b[k].r.chosen;
 			m->gain += b[k].r.gain;
-			m->cost = rect_cost(p, m, (double)out->w * out->h);
+			m->cost = rect_cost(p, m, plan_px(out));
 		} else {
 			out->regions[n++] = b[k].r;
 		}

@@ -56,6 +56,27 @@
 
 extern char **environ;
 
+/* malloc'd printf; NULL when out of memory. */
+static char *xprintf(const char *fmt, ...)
+{
+	va_list ap;
+	int n;
+	char *s;
+
+	va_start(ap, fmt);
+	n = vsnprintf(NULL, 0, fmt, ap);
+	va_end(ap);
+	if (n < 0)
+		return NULL;
+	s = malloc((size_t)n + 1);
+	if (!s)
+		return NULL;
+	va_start(ap, fmt);
+	vsnprintf(s, (size_t)n + 1, fmt, ap);
+	va_end(ap);
+	return s;
+}
+
 /*
  * The environment POV-Ray runs in: ours, with povwait.so (driver/povwait/)
  * preloaded, which cuts the polling waits POV-Ray spends most of a small
@@ -63,7 +84,6 @@ extern char **environ;
  * executable, or $POVPRESS_POVWAIT's (a path; "0" or empty: none).  Built
  * once, before any render starts, and never changed.
  */
-static char *xprintf(const char *fmt, ...);
 static pthread_once_t env_once = PTHREAD_ONCE_INIT;
 static char **env_pov;			/* NULL: environ */
 static char env_lib[PATH_MAX];		/* the library preloaded, or "" */
@@ -129,27 +149,6 @@ const char *pov_wait_library(void)
 {
 	pthread_once(&env_once, env_build);
 	return env_lib[0] ? env_lib : NULL;
-}
-
-/* malloc'd printf; NULL when out of memory. */
-static char *xprintf(const char *fmt, ...)
-{
-	va_list ap;
-	int n;
-	char *s;
-
-	va_start(ap, fmt);
-	n = vsnprintf(NULL, 0, fmt, ap);
-	va_end(ap);
-	if (n < 0)
-		return NULL;
-	s = malloc((size_t)n + 1);
-	if (!s)
-		return NULL;
-	va_start(ap, fmt);
-	vsnprintf(s, (size_t)n + 1, fmt, ap);
-	va_end(ap);
-	return s;
 }
 
 static double now_s(void)

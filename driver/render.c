@@ -301,6 +301,16 @@ static double elapsed(const struct run *r)
 	return r->prev_wall + now_s() - r->t0;
 }
 
+/* Seconds from now to a render's deadline: the budget's end less reserve,
+ * at least 0.01 s; 0 (none) without a budget. */
+static double deadline_in(const struct run *r, double reserve)
+{
+	if (!(r->budget > 0.0))
+		return 0.0;
+	double left = r->budget - elapsed(r) - reserve;
+	return left < 0.01 ? 0.01 : left;
+}
+
 /* Remove the work directory's files (ours only: nothing below it is a
  * directory but POV-Ray's link targets, which are links). */
 static void remove_workdir(const char *dir)
@@ -1329,11 +1339,8 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	 * image when stopped, and with no base pass there is nothing to refine
 	 * (a scene whose base pass takes minutes, given --budget 20, would
 	 * otherwise run for minutes) */
-	double left = r->budget > 0.0 ? r->budget - elapsed(r) : 0.0;
-	if (r->budget > 0.0 && left < 0.01)
-		left = 0.01;
-	int ret = whole_frame(r, 1, r->cores, out, r->radfile, "base pass", left, &res, err,
-			      errlen);
+	int ret = whole_frame(r, 1, r->cores, out, r->radfile, "base pass", deadline_in(r, 0.0),
+			      &res, err, errlen);
 	if (ret)
 		goto out;
 	ret = -1;
@@ -1716,9 +1723,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		 * average: glossy_reflection at --budget 8 ended at 10.9 s):
 		 * regions still rendering when only the analysis's time is
 		 * left are stopped, and what they did is lost */
-		po.deadline_s = r->budget - elapsed(r) - reserve;
-		if (po.deadline_s < 0.01)
-			po.deadline_s = 0.01;
+		po.deadline_s = deadline_in(r, reserve);
 	}
 	r->pool_done = 0;
 	r->pool_total = (int)n;

@@ -87,6 +87,13 @@ __attribute__((constructor)) static void povwait_init(void)
 	active = name && strncmp(name, "povray", 6) == 0;
 }
 
+/* Whether t is a valid timespec (the real function reports one that is
+ * not). */
+static int valid(const struct timespec *t)
+{
+	return t->tv_nsec >= 0 && t->tv_nsec < NS;
+}
+
 /* A relative wait of ns: how long to wait instead. */
 static long long cut(long long ns)
 {
@@ -105,11 +112,9 @@ int clock_nanosleep(clockid_t c, int flags, const struct timespec *req, struct t
 {
 	struct timespec r;
 
-	if (!real_sleep)
-		resolve();
-	if (!real_sleep)
+	if (!real_sleep && (resolve(), !real_sleep))
 		return ENOSYS;
-	if (!req || req->tv_nsec < 0 || req->tv_nsec >= NS)
+	if (!req || !valid(req))
 		return real_sleep(c, flags, req, rem);
 	r = (flags & TIMER_ABSTIME) ? cut_abs(c, req) : ts_of(cut(ns_of(req)));
 	return real_sleep(c, flags, &r, rem);
@@ -131,16 +136,14 @@ int pthread_cond_timedwait(pthread_cond_t *cv, pthread_mutex_t *m, const struct 
 	struct timespec d;
 	long long left;
 
-	if (!real_timedwait)
-		resolve();
-	if (!real_timedwait)
+	if (!real_timedwait && (resolve(), !real_timedwait))
 		return ENOSYS;
-	if (!active || abst->tv_nsec < 0 || abst->tv_nsec >= NS)
+	if (!active || !valid(abst))
 		return real_timedwait(cv, m, abst);
-	/* The condition variable's clock is not to be read from it: the
-	 * deadline is near one of the two clocks (decades apart). */
+	/* The condition variable's clock is not to be read from it: a poll's
+	 * deadline is near one of the two clocks (decades apart) */
 	left = ns_of(abst) - now_ns(CLOCK_REALTIME);
-	d = left == cut(left) ? cut_abs(CLOCK_MONOTONIC, abst) : cut_abs(CLOCK_REALTIME, abst);
+	d = cut_abs(left == cut(left) ? CLOCK_MONOTONIC : CLOCK_REALTIME, abst);
 	return real_timedwait(cv, m, &d);
 }
 
@@ -149,11 +152,9 @@ int pthread_cond_clockwait(pthread_cond_t *cv, pthread_mutex_t *m, clockid_t c,
 {
 	struct timespec d;
 
-	if (!real_clockwait)
-		resolve();
-	if (!real_clockwait)
+	if (!real_clockwait && (resolve(), !real_clockwait))
 		return ENOSYS;
-	if (!active || abst->tv_nsec < 0 || abst->tv_nsec >= NS)
+	if (!active || !valid(abst))
 		return real_clockwait(cv, m, c, abst);
 	d = cut_abs(c, abst);
 	return real_clockwait(cv, m, c, &d);
