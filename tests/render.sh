@@ -594,25 +594,37 @@ check "... no output file" test ! -e "$T/bb.exr"
 check "... no POV-Ray child left" no_povray_left "$T/bb work"
 
 # --- --prelaunch: renders started a pass early, taken or stopped -----------
-for m in auto off; do
-	"$PP" render "$SC/soft_shadows.pov" -o "$T/pl-$m.exr" -W $W -H $H --budget 3 \
-		--target 1e-6 --prelaunch $m --workdir "$T/pl $m" --keep-workdir \
+# auto starts them only without povwait.so (POVPRESS_POVWAIT=0: "noWait")
+for m in on off auto noWait; do
+	pm=$m envs=(env)
+	[[ $m = noWait ]] && pm=auto envs=(env POVPRESS_POVWAIT=0)
+	"${envs[@]}" "$PP" render "$SC/soft_shadows.pov" -o "$T/pl-$m.exr" -W $W -H $H --budget 3 \
+		--target 1e-6 --prelaunch $pm --workdir "$T/pl $m" --keep-workdir \
 		--report "$T/pl-$m.json" -v 2>"$T/pl-$m.log"
 	eval "rc_$m=$?"
 done
-taken=$(grep '"pass": 1,' "$T/pl-auto.json" | grep -o '"prelaunched": [0-9]*' | awk '{ print $2 }')
-check "--prelaunch auto under a budget: the run succeeds" test "$rc_auto" -eq 0
+taken=$(grep '"pass": 1,' "$T/pl-on.json" | grep -o '"prelaunched": [0-9]*' | awk '{ print $2 }')
+check "--prelaunch on under a budget: the run succeeds" test "$rc_on" -eq 0
 check "... its first pass takes renders started with the base pass ($taken)" \
 	test "${taken:-0}" -ge 1
-check "... and says so" grep -q "started with the base pass" "$T/pl-auto.log"
-check "... the report names the mode" grep -q '"prelaunch": "auto"' "$T/pl-auto.json"
+check "... and says so" grep -q "started with the base pass" "$T/pl-on.log"
+check "... the report names the mode" grep -q '"prelaunch": "on"' "$T/pl-on.json"
 check "... no gate left in the work directory" \
-	test -z "$(find "$T/pl auto" -name 'gate-*')"
-check "... no POV-Ray child left" no_povray_left "$T/pl auto"
-check "... the output is a complete image" valid_exr "$T/pl-auto.exr"
-check "--prelaunch off: the run succeeds" test "$rc_off" -eq 0
-check "... and no pass takes an early render" \
-	test "$(grep -o '"prelaunched": [1-9]' "$T/pl-off.json" | wc -l)" -eq 0
+	test -z "$(find "$T/pl on" -name 'gate-*')"
+check "... no POV-Ray child left" no_povray_left "$T/pl on"
+check "... the output is a complete image" valid_exr "$T/pl-on.exr"
+for m in off auto; do
+	check "--prelaunch $m (povwait.so on): the run succeeds" test "$(eval echo \$rc_$m)" -eq 0
+	check "... and no pass takes an early render" \
+		test "$(grep -o '"prelaunched": [1-9]' "$T/pl-$m.json" | wc -l)" -eq 0
+done
+check "... the report names auto" grep -q '"prelaunch": "auto"' "$T/pl-auto.json"
+taken=$(grep '"pass": 1,' "$T/pl-noWait.json" | grep -o '"prelaunched": [0-9]*' | awk '{ print $2 }')
+check "--prelaunch auto without povwait.so under a budget: the run succeeds" \
+	test "$rc_noWait" -eq 0
+check "... its report says povwait off" grep -q '"povwait": false' "$T/pl-noWait.json"
+check "... its first pass takes renders started with the base pass ($taken)" \
+	test "${taken:-0}" -ge 1
 "$PP" render "$SC/soft_shadows.pov" -o "$T/pl-bad.exr" --prelaunch maybe 2>"$T/pl-bad.log"
 check "--prelaunch maybe is a usage error (2)" test $? -eq 2
 check "... whose message names the option" grep -q -- "--prelaunch" "$T/pl-bad.log"
@@ -633,30 +645,30 @@ check "a scene needing the user's +HI header renders under a budget" test $? -eq
 check "... and no early render took the header's place" \
 	test "$(grep -o '"prelaunched": [1-9]' "$T/hi/r.json" | wc -l)" -eq 0
 # a radiosity scene under a budget: its radiosity pass is started with the
-# base pass and taken from its gate; with --prelaunch off it starts afresh
-for m in auto off; do
+# base pass and taken from its gate (--prelaunch on); with off it starts afresh
+for m in on off; do
 	"$PP" render "$SC/radiosity_room.pov" -o "$T/rp-$m.exr" -W 80 -H 60 --budget 4 \
 		--target 1e-6 --max-passes 0 --prelaunch $m --workdir "$T/rp $m" --keep-workdir \
 		--report "$T/rp-$m.json" -v 2>"$T/rp-$m.log"
 	eval "rprc_$m=$?"
 done
-check "radiosity under a budget, --prelaunch auto: the run succeeds" test "$rprc_auto" -eq 0
+check "radiosity under a budget, --prelaunch on: the run succeeds" test "$rprc_on" -eq 0
 check "... its radiosity pass was started early" \
-	grep -q "the radiosity pass was started early" "$T/rp-auto.log"
+	grep -q "the radiosity pass was started early" "$T/rp-on.log"
 check "... the base pass's record counts it" \
-	grep -q '"pass": 0,.*"prelaunched": 1' "$T/rp-auto.json"
-check "... no gate left in the work directory" test -z "$(find "$T/rp auto" -name 'gate-*')"
-check "... no POV-Ray child left" no_povray_left "$T/rp auto"
-check "... the output is a complete image" valid_exr "$T/rp-auto.exr"
-check "... its radiosity pass ran at scale 4" grep -q '"radiosity_scale": 4' "$T/rp-auto.json"
+	grep -q '"pass": 0,.*"prelaunched": 1' "$T/rp-on.json"
+check "... no gate left in the work directory" test -z "$(find "$T/rp on" -name 'gate-*')"
+check "... no POV-Ray child left" no_povray_left "$T/rp on"
+check "... the output is a complete image" valid_exr "$T/rp-on.exr"
+check "... its radiosity pass ran at scale 4" grep -q '"radiosity_scale": 4' "$T/rp-on.json"
 check "radiosity under a budget, --prelaunch off: the run succeeds" test "$rprc_off" -eq 0
 check "... and no render was started early" \
 	test "$(grep -o '"prelaunched": [1-9]' "$T/rp-off.json" | wc -l)" -eq 0
 check "... the same image either way (one thread, the same solution)" \
-	test "$("$PP" compare "$T/rp-auto.exr" "$T/rp-off.exr" | sed -n 's/^relmse: //p')" = 0
+	test "$("$PP" compare "$T/rp-on.exr" "$T/rp-off.exr" | sed -n 's/^relmse: //p')" = 0
 # interrupted while the early renders wait at their gates
 "$PP" render "$SC/focal_blur.pov" -o "$T/pl-int.exr" -W $W -H $H --budget 5 --target 1e-6 \
-	-q --workdir "$T/pl int" &
+	--prelaunch on -q --workdir "$T/pl int" &
 pid=$!
 sleep 0.2
 kill -INT $pid
