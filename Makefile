@@ -24,10 +24,13 @@ LIB_DRV_OBJ = $(filter-out $(BUILD)/driver/main.o,$(DRV_OBJ))
 UNIT_SRC = $(wildcard tests/test_*.c)
 UNIT_BIN = $(UNIT_SRC:tests/%.c=$(BUILD)/tests/%)
 TOOL_BIN = $(BUILD)/tests/gen_image $(BUILD)/bench/bench_analyze $(BUILD)/bench/bench_denoise
+# povpress and the library it preloads into POV-Ray: what every target that
+# renders needs
+RENDER_BIN = $(BUILD)/povpress $(BUILD)/povwait.so
 
 .PHONY: all check unit e2e bench clean deps demo sweep sampler
 .SECONDARY:
-all: $(BUILD)/povpress $(BUILD)/povwait.so
+all: $(RENDER_BIN)
 
 # The Debian packages are installed (when missing) once per build tree.
 $(BUILD)/.deps: scripts/install-deps.sh
@@ -78,7 +81,7 @@ deps: $(BUILD)/.deps
 unit: $(UNIT_BIN)
 	@set -e; for t in $(UNIT_BIN); do echo "== $$t"; $$t; done
 
-e2e: $(BUILD)/povpress $(BUILD)/povwait.so $(BUILD)/tests/povray_waits $(BUILD)/tests/gen_image $(BUILD)/tools/boxdown
+e2e: $(RENDER_BIN) $(BUILD)/tests/povray_waits $(BUILD)/tests/gen_image $(BUILD)/tools/boxdown
 	tests/e2e.sh $(BUILD)
 	tests/render.sh $(BUILD)
 
@@ -88,20 +91,20 @@ check: unit e2e
 # bundled scenes in quick mode (BENCH_ARGS="scenes/media.pov" for one scene;
 # `make sweep` is the full benchmark).
 BENCH_ARGS ?=
-bench: $(BUILD)/bench/bench_analyze $(BUILD)/bench/bench_denoise $(BUILD)/povpress $(BUILD)/povwait.so \
+bench: $(BUILD)/bench/bench_analyze $(BUILD)/bench/bench_denoise $(RENDER_BIN) \
 		$(BUILD)/tools/boxdown
 	$(BUILD)/bench/bench_analyze
 	$(BUILD)/bench/bench_denoise
 	BUILD=$(BUILD) scripts/sweep.sh --quick $(BENCH_ARGS)
 
-demo: $(BUILD)/povpress $(BUILD)/povwait.so $(BUILD)/tools/boxdown
+demo: $(RENDER_BIN) $(BUILD)/tools/boxdown
 	scripts/demo.sh $(BUILD)
 
-sweep: $(BUILD)/povpress $(BUILD)/povwait.so $(BUILD)/tools/boxdown
+sweep: $(RENDER_BIN) $(BUILD)/tools/boxdown
 	BUILD=$(BUILD) scripts/sweep.sh $(SWEEP_ARGS)
 
 # How a region gets more samples: +AM2 against resolution scaling, measured.
-sampler: $(BUILD)/povpress $(BUILD)/povwait.so $(BUILD)/tools/boxdown
+sampler: $(RENDER_BIN) $(BUILD)/tools/boxdown
 	scripts/sampler.sh $(BUILD)
 
 clean:
