@@ -828,10 +828,70 @@ own_share() {
 	echo "of a scene's runs: ${line%, }."
 }
 
+# goals: the table's rows tallied against issue 4's goals (relMSE at most
+# 0.5x POV-Ray's envelope at equal CPU; never above 1.0x on a stochastic
+# scene, nor above 1.25x anywhere; the estimate within 1.5x of the truth;
+# capture20 within 90% of the oracle's), over the scenes with visible error
+# (no-AA relMSE 1e-6 or more), and every budget run's wall time against its
+# budget.  Reads the table on stdin.
+goals() {
+	local rep=$CSV
+	((REPEAT > 1)) && [[ -s $RCSV ]] && rep=$RCSV
+	awk -F'|' -v csv="$CSV" -v rep="$rep" '
+	function trim(s) { gsub(/^ +| +$/, "", s); return s }
+	BEGIN {
+		while ((getline line < csv) > 0) {
+			split(line, f, ",")
+			if (f[2] == "noaa") noaa[f[1]] = f[6] + 0
+		}
+		close(csv)
+		while ((getline line < rep) > 0) {
+			split(line, f, ",")
+			if (f[2] != "povpress" || f[3] !~ /^budget /) continue
+			b = substr(f[3], 8) + 0; if (!(b in nb)) order[++nbs] = b; nb[b]++
+			if (f[5] + 0 > longest[b]) longest[b] = f[5] + 0
+			nbud++; if (f[5] + 0 <= b) within++
+		}
+	}
+	{
+		sc = trim($2); run = trim($3); q = trim($8); sub(/ .*/, "", q)
+		if (!(sc in noaa) || q == "-") next
+		if (noaa[sc] < 1e-6) { skipped[sc] = 1; next }
+		n++; q += 0; lg += log(q)
+		if (q <= 0.5) half++; else miss = miss sprintf("%s%s %s %.2f", miss == "" ? "" : "; ", sc, run, q)
+		if (q > 1.0) over1++
+		if (q > 1.25) over125++
+		e = trim($10); x = trim($11); if (x == "-") x = e
+		if (e != "-") { e += 0; if (e <= 1.5 && e >= 1 / 1.5) est++ }
+		if (x != "-") { x += 0; if (x <= 1.5 && x >= 1 / 1.5) estx++ }
+		split(trim($12), c, " / ")
+		if (c[2] + 0 > 0 && c[1] + 0 >= 0.9 * c[2]) cap++
+	}
+	END {
+		if (!n) exit
+		for (s in skipped) left = left (left == "" ? "" : ", ") s
+		printf "\nAgainst issue 4'"'"'s goals, over the %d runs of the scenes with visible error", n
+		if (left != "") printf " (%s left out: no-AA relMSE below 1e-6)", left
+		printf ": ratio at or below 0.5 on %d, above 1.0 on %d, above 1.25 on %d, geometric mean %.2f; ", \
+			half + 0, over1 + 0, over125 + 0, exp(lg / n)
+		printf "the estimate within 1.5x of the true relMSE on %d, and on %d with the reference'"'"'s own error taken off the true one ", est + 0, estx + 0
+		printf "where the table gives it; capture20 at or above 90%% of the oracle'"'"'s on %d.", cap + 0
+		if (nbud) {
+			printf " Budget runs (every run) ended within their budgets on %d of %d", within + 0, nbud
+			sep = " (longest: "
+			for (k = 1; k <= nbs; k++) { printf "%s%g s budget %.3f s", sep, order[k], longest[order[k]]; sep = ", " }
+			printf ")."
+		}
+		printf "\n"
+		if (miss != "") printf "Above 0.5: %s.\n", miss
+	}'
+}
+
 echo
 echo "povpress render against POV-Ray's lower envelope (ratio < 1: povpress has the lower relMSE):"
 PPT=$(pp_table)
 echo "$PPT" | awk -F'|' '{ printf "%-18s %-14s cpu %6s  relMSE %-9s POV-Ray %-22s ratio %-5s speed-up %s\n", $2, $3, $4, $6, $7, $8, $9 }'
+echo "$PPT" | goals
 {
 	echo
 	echo "## povpress render against POV-Ray's best"
@@ -860,6 +920,7 @@ echo "$PPT" | awk -F'|' '{ printf "%-18s %-14s cpu %6s  relMSE %-9s POV-Ray %-22
 	echo "| scene | run | CPU s | wall s | relMSE | POV-Ray at equal CPU | ratio | equal-error speed-up | est/true | less ref | capture20 / oracle / local |"
 	echo "|---|---|---|---|---|---|---|---|---|---|---|"
 	echo "$PPT"
+	echo "$PPT" | goals
 	own_share
 } >>"$SUM"
 

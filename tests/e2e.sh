@@ -253,6 +253,26 @@ check "sweep: ... the envelope at the row's CPU and its setting" \
 	grep -qF "| 0.001 (am2 x) |" <<<"$row"
 REPEAT=1
 check "sweep: one run per setting: no range" grep -qF "| 2.00 |" <<<"$(pp_table)"
+# goals: the table tallied against issue 4's goals, scenes without visible
+# error left out, every budget run's wall time against its budget
+eval "$(sed -n '/^goals() {/,/^}/p' "$ROOT/scripts/sweep.sh")"
+CSV=$T/g.csv RCSV=$T/g-rep.csv REPEAT=3
+printf '%s\n' scene,method,setting,cpu_s,wall_s,relmse A,noaa,-,0.1,1,0.01 Z,noaa,-,0.1,1,1e-9 >"$CSV"
+printf '%s\n' scene,method,setting,cpu_s,wall_s,relmse "A,povpress,budget 2,2,1.9,0.002" \
+	"A,povpress,budget 2,2,2.1,0.002" "A,povpress,target 1,1,1,0.002" >"$RCSV"
+g=$(printf '%s\n' \
+	'| A | target 1 | 1 | 1 | 0.002 | 0.004 (x) | 0.50 (0.40-0.60) | - | 1.20 | 1.60 | 0.90 / 1.00 (90%) / 0.95 |' \
+	'| A | budget 2 | 2 | 1.9 | 0.002 | 0.0015 (x) | 1.33 | - | 2.00 | - | 0.50 / 1.00 (50%) |' \
+	'| Z | target 1 | 1 | 1 | 3e-9 | 1e-9 (x) | 3.00 | - | 9.00 | - | 0.10 / 1.00 (10%) |' | goals)
+check "sweep: goals: two runs counted, Z left out" grep -qF "over the 2 runs of the scenes with visible error (Z left out" <<<"$g"
+check "sweep: goals: 0.5 met on one, 1.0 and 1.25 passed on one, geometric mean 0.82" \
+	grep -qF "at or below 0.5 on 1, above 1.0 on 1, above 1.25 on 1, geometric mean 0.82;" <<<"$g"
+check "sweep: goals: the estimate within 1.5x on one, on none less the reference's own" \
+	grep -qF "within 1.5x of the true relMSE on 1, and on 0 with the reference's own error taken off" <<<"$g"
+check "sweep: goals: capture20 at 90% of the oracle's counts" grep -qF "oracle's on 1." <<<"$g"
+check "sweep: goals: budget runs from every run, the longest" \
+	grep -qF "within their budgets on 1 of 2 (longest: 2 s budget 2.100 s)" <<<"$g"
+check "sweep: goals: the runs above 0.5 named" grep -qxF "Above 0.5: A budget 2 1.33." <<<"$g"
 "$ROOT/scripts/sweep.sh" --repeat 0 >"$T/rep.out" 2>&1
 check "sweep: --repeat 0 is a usage error (2)" test $? -eq 2
 check "sweep: ... naming --repeat" grep -q -- "--repeat '0'" "$T/rep.out"
