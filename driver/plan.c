@@ -1079,16 +1079,18 @@ fail:
 	return -1;
 }
 
-/* qsort() order for plan_sparse_error(): the largest first */
+/* qsort() order for top_holds(): the largest first */
 static int by_descending(const void *a, const void *b)
 {
 	double x = *(const double *)a, y = *(const double *)b;
 	return x < y ? 1 : x > y ? -1 : 0;
 }
 
-int plan_sparse_error(const double *e, size_t n)
+/* Whether the largest share of the values e (n of them; at least one) hold
+ * frac of their sum or more (plan.h). */
+static int top_holds(const double *e, size_t n, double share, double frac)
 {
-	size_t m = (size_t)(PLAN_SPARSE_SHARE * (double)n), top = m ? m : 1;
+	size_t m = (size_t)(share * (double)n), top = m ? m : 1;
 	double *v = malloc(n * sizeof(*v)), all = 0.0, big = 0.0;
 	if (!v)
 		return 0;	/* the default samplers serve either way */
@@ -1102,5 +1104,15 @@ int plan_sparse_error(const double *e, size_t n)
 	for (size_t i = 0; i < top && i < k; i++)
 		big += v[i];
 	free(v);
-	return all > 0.0 && big >= 0.5 * all;
+	return all > 0.0 && big >= frac * all;
+}
+
+int plan_sparse_error(const double *e, size_t n)
+{
+	return top_holds(e, n, PLAN_SPARSE_SHARE, 0.5);
+}
+
+int plan_edge_error(const double *e, size_t n)
+{
+	return top_holds(e, n, PLAN_EDGE_SHARE, PLAN_EDGE_FRAC);
 }

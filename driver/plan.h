@@ -211,4 +211,26 @@ int plan_regions_read(const char *path, struct plan_region **regions, char ***ou
 #define PLAN_SPARSE_SHARE 0.001
 int plan_sparse_error(const double *e, size_t n);
 
+/*
+ * Whether the estimated errors e (n pixels) sit at edges: the largest
+ * PLAN_EDGE_SHARE of them (at least one) holding PLAN_EDGE_FRAC of their
+ * sum or more, on the same terms as plan_sparse_error().  Where a scene's
+ * noise is low and its error is its edges' aliasing, POV-Ray's adaptive
+ * antialiasing, which subdivides only where corners differ, does far more
+ * for the CPU than scale 2's 4 samples over the rectangles.  After the base
+ * pass at 160x120 (2026-12-02, `povpress render S --max-passes 0
+ * --error-map M`, the relerror channel): 0.76 to 0.88 on Debian's
+ * lights/arealit1, arealit2, arealit3 and advanced/lamppost and 0.77 on
+ * still_life (0.93 at 320x240, 0.64 at 80x60: the edges' share of the
+ * pixels grows as the image shrinks), 0.91 and 1.00 on hdr_highlights and
+ * starfield; 0.19 to 0.58 on the other bundled scenes (soft_shadows 0.54,
+ * thin_geometry 0.49) and on Debian's wineglass, woodbox, isosurfaces,
+ * blob, bwstripe and whiltile, where the error is noise or texture spread
+ * over the frame (radiosity_room 1.00: its radiosity solution's; render.c
+ * leaves radiosity scenes out).  The bound sits between the two groups.
+ */
+#define PLAN_EDGE_SHARE 0.05
+#define PLAN_EDGE_FRAC 0.67
+int plan_edge_error(const double *e, size_t n);
+
 #endif

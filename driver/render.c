@@ -110,7 +110,9 @@ static const char usage_options[] =
 	"                        focal blur (aperture and blur_samples), where\n"
 	"                        POV-Ray's antialiasing converges slowly; where the\n"
 	"                        estimated error sits in a few pixels, 0.1% of them\n"
-	"                        holding half of it, as at highlights, scale 2 as\n"
+	"                        holding half of it, as at highlights, or after the\n"
+	"                        base pass at edges, 5% of them holding two thirds\n"
+	"                        (not with radiosity or focal blur), scale 2 as\n"
 	"                        one render at twice the size\n"
 	"                        with POV-Ray's +AM2 +A0.1 +R3 +J; where it is spread\n"
 	"                        and the frame at scale 4 takes less than 0.7 s on\n"
@@ -1455,19 +1457,27 @@ static int has_scale2(const struct plan *pl)
 	return 0;
 }
 
-/* plan_sparse_error() of the pixels' estimate, which a pass may ask twice
- * (one_step(), choose_samplers()): a sort of w*h values, so kept in *memo
+/* Whether the pixels' estimated error sits in a few pixels or, after the
+ * base pass of a scene with neither radiosity (whose error is its
+ * solution's) nor focal blur (where antialiasing's samples are worth a
+ * quarter of scaling's), at edges: plan_sparse_error() or
+ * plan_edge_error().  A pass may ask twice
+ * (one_step(), choose_samplers()): sorts of w*h values, so kept in *memo
  * (-1 until asked) for the pass. */
 static int sparse_error(const struct run *r, int *memo)
 {
-	if (*memo < 0)
-		*memo = plan_sparse_error(r->est, (size_t)r->w * r->h);
+	if (*memo < 0) {
+		const size_t n = (size_t)r->w * r->h;
+		*memo = plan_sparse_error(r->est, n) ||
+			(r->npasses == 1 && !r->radiosity && !r->focal &&
+			 plan_edge_error(r->est, n));
+	}
 	return *memo;
 }
 
 /*
  * The sampler of each region of a plan.  With --sampler auto, where the
- * error sits in a few pixels (plan_sparse_error()), the regions of scale 2 are
+ * error sits in a few pixels or at edges (sparse_error()), the regions of scale 2 are
  * rendered once at twice the image's size with POV-Ray's antialiasing,
  * +AM2 +A0.1 +R3 +J (frame ACC_GRID_FRAME; ACC_AA_FIRST for how they are folded): it
  * subdivides only where corners differ, down to 1/16 of a pixel at a
@@ -1514,7 +1524,7 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
  * Whether --sampler auto should go from the base pass straight to scale 4,
  * jittered (PLAN_GRID_ONLY, as --sampler jitter), for the rest of the run:
  * at the first refinement pass, where the error is spread (not
- * plan_sparse_error()), the scene has no radiosity, and the whole frame
+ * sparse_error()), the scene has no radiosity, and the whole frame
  * at scale 4, 16 samples a pixel, takes less than JITTER_FRAME_S on the
  * cores.  There jittering every pixel is cheap, and no regular grid of
  * scale 2 aliases into the mean or hides an edge from the estimate: on
@@ -1741,7 +1751,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 								    r->cores);
 	double guess = rounds * r->latency > cpu_wall ? rounds * r->latency : cpu_wall;
 	if (naa)
-		progress(r, "pass %d: the estimated error sits in few pixels: %zu regions by "
+		progress(r, "pass %d: the estimated error sits in few pixels or at edges: %zu regions by "
 			 "POV-Ray's antialiasing in place of scale 2", pass, naa);
 	progress(r, "pass %d: %zu regions, %ld pixels (%ld chosen), %.0f samples, about %.1f s",
 		 pass, n, pl.pixels, pl.chosen_pixels, pl.samples, guess + r->latency);

@@ -1535,6 +1535,45 @@ static void test_sparse_error(void **state)
 	assert_false(plan_sparse_error(f, 5));
 }
 
+/* 6c. plan_edge_error(): the largest 5% (at least one) of the pixels'
+ * errors holding two thirds (PLAN_EDGE_FRAC) of their sum. */
+static void test_edge_error(void **state)
+{
+	enum { N = 2000 };	/* 5% is 100 pixels */
+	double e[N];
+
+	(void)state;
+	for (int i = 0; i < N; i++)
+		e[i] = 1e-4;
+	assert_false(plan_edge_error(e, N));	/* spread */
+	/* 100 edge pixels at 4e-3: 0.4 of 0.4 + 0.19, 68% */
+	for (int i = 0; i < 100; i++)
+		e[i * 20] = 4e-3;
+	assert_true(plan_edge_error(e, N));
+	assert_false(plan_sparse_error(e, N));	/* not a few pixels: 2 of them hold 1.4% */
+	/* the rest a little noisier: 0.4 of 0.4 + 0.2090, 66% */
+	for (int i = 0; i < N; i++)
+		if (e[i] < 1e-3)
+			e[i] = 1.1e-4;
+	assert_false(plan_edge_error(e, N));
+	/* twice the edge pixels at half the error each: the largest 5% hold
+	 * half of the edges' error, 0.2 of 0.4 + 0.18 */
+	for (int i = 0; i < N; i++)
+		e[i] = i % 10 == 0 ? 2e-3 : 1e-4;
+	assert_false(plan_edge_error(e, N));
+	/* what is not finite or not positive is left out; one pixel holds it all */
+	for (int i = 0; i < N; i++)
+		e[i] = i % 2 ? NAN : 0.0;
+	assert_false(plan_edge_error(e, N));
+	e[4] = 1e-3;
+	assert_true(plan_edge_error(e, N));
+	/* a small image: at least one pixel */
+	double f[5] = { 1.0, 0.1, 0.1, 0.1, 0.1 };
+	assert_true(plan_edge_error(f, 5));
+	f[0] = 0.7;
+	assert_false(plan_edge_error(f, 5));
+}
+
 /* 7. The regions file round-trips; a bad line is reported with its number. */
 static void test_regions_file(void **state)
 {
@@ -1771,6 +1810,7 @@ int main(void)
 		cmocka_unit_test(test_pixel_errors_threads),
 		cmocka_unit_test(test_final_choice),
 		cmocka_unit_test(test_sparse_error),
+		cmocka_unit_test(test_edge_error),
 		cmocka_unit_test(test_regions_file),
 		cmocka_unit_test(test_plan_job),
 	};
