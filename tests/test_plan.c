@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "driver/accum.h"
+#include "driver/metrics.h"
 #include "driver/image.h"
 #include "driver/plan.h"
 #include "driver/povray.h"
@@ -699,6 +700,7 @@ static void test_merge_aa(void **state)
 	 * has one; and every pixel folded has scale 2 after it (planned at
 	 * scale 2 again, it would get the same render, which it refuses) */
 	make_acc(&acc, 4, 2, flat_value);
+	int bound = 0;
 	float *o3 = accpx(&acc, 3);
 	for (int c = 0; c < 3; c++)
 		o3[ACC_VAR_R + c] = (float)var[c];
@@ -725,7 +727,30 @@ static void test_merge_aa(void **state)
 		assert_true(o[ACC_SAMPLES] == (float)(1 + ACC_AA_FIRST));
 		assert_close(o[0], (flat_value(x, y, 0) + ACC_AA_FIRST * m) / (1 + ACC_AA_FIRST),
 			     1e-6, 0.0, "the base sample and the 2 x 2 mean");
+		/* the new mean's error: the difference from the base sample
+		 * over the weights, but no more than the 2 x 2 mean's variance */
+		double d = 0.0, v = 0.0;
+		for (int c = 0; c < 3; c++) {
+			double mc = 0.0, vc = 0.0;
+			for (int j = 0; j < 2; j++)
+				for (int l = 0; l < 2; l++)
+					mc += render_at(&big, 0, 2 * x + l, 2 * y + j, c) / 4.0;
+			for (int j = 0; j < 2; j++)
+				for (int l = 0; l < 2; l++) {
+					double t = render_at(&big, 0, 2 * x + l, 2 * y + j, c) - mc;
+					vc += t * t / 12.0;
+				}
+			double den = (double)o[c] * o[c] + METRICS_RELMSE_EPS;
+			d += (mc - flat_value(x, y, c)) * (mc - flat_value(x, y, c)) / den / 3.0;
+			v += vc / den / 3.0;
+		}
+		const double full = (ACC_AA_FIRST * ACC_AA_FIRST + 1.0) /
+				    ((1.0 + ACC_AA_FIRST) * (1.0 + ACC_AA_FIRST)) * d;
+		assert_close(o[ACC_DIFF], full < v ? full : v, 1e-4, 1e-12,
+			     "the first fold's error: the difference, at most the 2 x 2 spread");
+		bound += v < full;
 	}
+	assert_true(bound > 0);	/* the spread bound acted somewhere */
 	image_release(&big);
 	image_release(&acc);
 
