@@ -182,11 +182,13 @@ static double worth_samples(const struct accum_worth *w)
 
 /* Pixel (x, y)'s value in an antialiased render f times the image's size
  * (1, or ACC_GRID_FRAME in scale 2's place): the mean of its f x f render
- * pixels, into mean; 0 if one is not finite. */
+ * pixels, into mean, and, if var is not NULL, that mean's variance (their
+ * sample variance over f^2; 0 for f = 1); 0 if one is not finite. */
 static int aa_pixel(const struct image *img, int oy, const int ch[3], int f, int x, int y,
-		    double mean[3])
+		    double mean[3], double var[3])
 {
 	int ok = 1;
+	double sq[3] = { 0.0, 0.0, 0.0 };
 	for (int c = 0; c < 3; c++)
 		mean[c] = 0.0;
 	for (int j = 0; j < f; j++)
@@ -195,27 +197,16 @@ static int aa_pixel(const struct image *img, int oy, const int ch[3], int f, int
 						    (size_t)x * f + l) * img->nch;
 			for (int c = 0; c < 3; c++) {
 				mean[c] += p[ch[c]] / (double)(f * f);
+				sq[c] += (double)p[ch[c]] * p[ch[c]] / (double)(f * f);
 				ok &= isfinite(p[ch[c]]) != 0;
 			}
 		}
-	return ok;
-}
-
-/* The variance of aa_pixel()'s mean (f > 1), per channel: the f x f render
- * pixels' sample variance over f^2. */
-static void aa_pixel_var(const struct image *img, int oy, const int ch[3], int f, int x, int y,
-			 const double mean[3], double var[3])
-{
-	for (int c = 0; c < 3; c++)
-		var[c] = 0.0;
-	for (int j = 0; j < f; j++)
-		for (int l = 0; l < f; l++) {
-			const float *p = img->px + ((size_t)(y * f + j - oy) * img->w +
-						    (size_t)x * f + l) * img->nch;
-			for (int c = 0; c < 3; c++)
-				var[c] += (p[ch[c]] - mean[c]) * (p[ch[c]] - mean[c]) /
-					  ((double)(f * f - 1) * (f * f));
+	if (var)	/* the f x f pixels' sample variance over f^2 */
+		for (int c = 0; c < 3; c++) {
+			double v = f > 1 ? (sq[c] - mean[c] * mean[c]) / (f * f - 1) : 0.0;
+			var[c] = v > 0.0 ? v : 0.0;
 		}
+	return ok;
 }
 
 /* The worth of an antialiased render of a region (worth_samples()),
@@ -227,7 +218,7 @@ static int aa_worth(const struct image *acc, const struct image *img, int oy, co
 	for (int y = y0; y <= y1; y++)
 		for (int x = x0; x <= x1; x++) {
 			double mean[3];
-			aa_pixel(img, oy, ch, f, x, y, mean);
+			aa_pixel(img, oy, ch, f, x, y, mean, NULL);
 			worth_add(acc, (size_t)y * acc->w + x, ACC_AA, mean, &w);
 		}
 	return (int)lround(worth_samples(&w));
@@ -244,7 +235,8 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			size_t i = (size_t)y * acc->w + x;
 			const float *o = acc->px + i * ACC_NCH;
 			double mean[3], old[3], m2[3] = { 0.0, 0.0, 0.0 };
-			int ok = aa_pixel(img, oy, ch, f, x, y, mean);
+			double v[3];
+			int ok = aa_pixel(img, oy, ch, f, x, y, mean, v);
 			for (int c = 0; c < 3; c++)
 				old[c] = o[c];
 			if (!ok) {
@@ -304,8 +296,6 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			 * run at --target 1e-3 took a second pass that bought
 			 * nothing (2.8e-5 in 35 CPU s against 2.6e-5 in 9 s). */
 			if (first) {
-				double v[3];
-				aa_pixel_var(img, oy, ch, f, x, y, mean, v);
 				double rv = rel3(o, v);
 				if (isfinite(rv) && rv < diff)
 					diff = rv;
