@@ -330,12 +330,20 @@ check "focal blur: only --sampler auto looks for it" grep -q '"focal_blur": fals
 # hdr_highlights' lamps and their reflections hold half the base pass's
 # estimated error in 0.1% of the pixels at 160x120 (at 80x60, 0.1% is 4
 # pixels and they hold a quarter); soft_shadows' is spread.
+# auto_and_scale TAG SCENE: SCENE at 160x120 and --target 3e-3 with --sampler
+# auto and scale, into $T/TAG-auto.exr and $T/TAG-scale.exr (their work
+# directories kept, the -v logs in $T/TAG-auto.log and $T/TAG-scale.log)
+auto_and_scale() {
+	local m
+	for m in auto scale; do
+		"$PP" render "$2" -o "$T/$1-$m.exr" -W 160 -H 120 --target 3e-3 --sampler $m \
+			-v --keep-workdir -- +WT1 2>"$T/$1-$m.log" ||
+			bad "$(basename "$2" .pov), --sampler $m: render failed"
+	done
+}
 scene="$SC/hdr_highlights.pov"
 if ref=$(W=160 H=120 reference "$scene"); then
-	for m in auto scale; do
-		"$PP" render "$scene" -o "$T/hl-$m.exr" -W 160 -H 120 --target 3e-3 --sampler $m \
-			-v --keep-workdir -- +WT1 2>"$T/hl-$m.log" || bad "highlights, --sampler $m: render failed"
-	done
+	auto_and_scale hl "$scene"
 	check "highlights: the first pass renders antialiased regions in scale 2's place" \
 		test -n "$(compgen -G "$T/hl-auto.exr.work/p01-*-aa.exr")"
 	check "... and no scale-2 region" test -z "$(compgen -G "$T/hl-auto.exr.work/p01-*-s2.exr")"
@@ -360,10 +368,7 @@ fi
 # in as few pixels, but it is the radiosity solution's: no antialiasing.
 scene="$SC/still_life.pov"
 if ref=$(S=9 W=160 H=120 reference "$scene"); then
-	for m in auto scale; do
-		"$PP" render "$scene" -o "$T/sl-$m.exr" -W 160 -H 120 --target 3e-3 --sampler $m \
-			-v --keep-workdir -- +WT1 2>"$T/sl-$m.log" || bad "still_life, --sampler $m: render failed"
-	done
+	auto_and_scale sl "$scene"
 	check "still_life: the first pass renders antialiased regions in scale 2's place" \
 		test -n "$(compgen -G "$T/sl-auto.exr.work/p01-*-aa.exr")"
 	check "... and says why" grep -q "error sits in few pixels or at edges" "$T/sl-auto.log"
