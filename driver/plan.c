@@ -1079,19 +1079,27 @@ fail:
 	return -1;
 }
 
-/* qsort() order for top_holds(): the largest first */
+/* qsort() order for plan_error_where(): the largest first */
 static int by_descending(const void *a, const void *b)
 {
 	double x = *(const double *)a, y = *(const double *)b;
 	return x < y ? 1 : x > y ? -1 : 0;
 }
 
-/* Whether the largest share of the values e (n of them; at least one) hold
- * frac of their sum or more (plan.h). */
-static int top_holds(const double *e, size_t n, double share, double frac)
+/* The sum of the largest share of the sorted values v (k of them, of n
+ * pixels; at least one). */
+static double top_sum(const double *v, size_t k, size_t n, double share)
 {
 	size_t m = (size_t)(share * (double)n), top = m ? m : 1;
-	double *v = malloc(n * sizeof(*v)), all = 0.0, big = 0.0;
+	double big = 0.0;
+	for (size_t i = 0; i < top && i < k; i++)
+		big += v[i];
+	return big;
+}
+
+unsigned plan_error_where(const double *e, size_t n)
+{
+	double *v = malloc(n * sizeof(*v)), all = 0.0;
 	if (!v)
 		return 0;	/* the default samplers serve either way */
 	size_t k = 0;
@@ -1101,18 +1109,21 @@ static int top_holds(const double *e, size_t n, double share, double frac)
 			all += e[i];
 		}
 	qsort(v, k, sizeof(*v), by_descending);
-	for (size_t i = 0; i < top && i < k; i++)
-		big += v[i];
+	unsigned where = 0;
+	if (all > 0.0 && top_sum(v, k, n, PLAN_SPARSE_SHARE) >= 0.5 * all)
+		where |= PLAN_ERROR_FEW;
+	if (all > 0.0 && top_sum(v, k, n, PLAN_EDGE_SHARE) >= PLAN_EDGE_FRAC * all)
+		where |= PLAN_ERROR_EDGES;
 	free(v);
-	return all > 0.0 && big >= frac * all;
+	return where;
 }
 
 int plan_sparse_error(const double *e, size_t n)
 {
-	return top_holds(e, n, PLAN_SPARSE_SHARE, 0.5);
+	return (plan_error_where(e, n) & PLAN_ERROR_FEW) != 0;
 }
 
 int plan_edge_error(const double *e, size_t n)
 {
-	return top_holds(e, n, PLAN_EDGE_SHARE, PLAN_EDGE_FRAC);
+	return (plan_error_where(e, n) & PLAN_ERROR_EDGES) != 0;
 }

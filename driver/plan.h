@@ -223,7 +223,7 @@ int plan_sparse_error(const double *e, size_t n);
  * lights/arealit1, arealit2, arealit3 and advanced/lamppost and 0.77 on
  * still_life (0.93 at 320x240, 0.64 at 80x60: the edges' share of the
  * pixels grows as the image shrinks), 0.91 and 1.00 on hdr_highlights and
- * starfield; 0.19 to 0.58 on the other bundled scenes (soft_shadows 0.54,
+ * starfield; 0.11 to 0.58 on the other bundled scenes (soft_shadows 0.54,
  * thin_geometry 0.49) and on Debian's wineglass, woodbox, isosurfaces,
  * blob, bwstripe and whiltile, where the error is noise or texture spread
  * over the frame (radiosity_room 1.00: its radiosity solution's; render.c
@@ -232,5 +232,10 @@ int plan_sparse_error(const double *e, size_t n);
 #define PLAN_EDGE_SHARE 0.05
 #define PLAN_EDGE_FRAC 0.67
 int plan_edge_error(const double *e, size_t n);
+
+/* Both of the above from one sort of the errors: PLAN_ERROR_FEW if
+ * plan_sparse_error(), PLAN_ERROR_EDGES if plan_edge_error(). */
+enum { PLAN_ERROR_FEW = 1u, PLAN_ERROR_EDGES = 2u };
+unsigned plan_error_where(const double *e, size_t n);
 
 #endif

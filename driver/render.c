@@ -1460,17 +1460,15 @@ static int has_scale2(const struct plan *pl)
 /* Whether the pixels' estimated error sits in a few pixels or, after the
  * base pass of a scene with neither radiosity (whose error is its
  * solution's) nor focal blur (where antialiasing's samples are worth a
- * quarter of scaling's), at edges: plan_sparse_error() or
- * plan_edge_error().  A pass may ask twice
- * (one_step(), choose_samplers()): sorts of w*h values, so kept in *memo
- * (-1 until asked) for the pass. */
+ * quarter of scaling's), at edges (plan_error_where()).  A pass may ask
+ * twice (one_step(), choose_samplers()): a sort of w*h values, so kept in
+ * *memo (-1 until asked) for the pass. */
 static int sparse_error(const struct run *r, int *memo)
 {
 	if (*memo < 0) {
-		const size_t n = (size_t)r->w * r->h;
-		*memo = plan_sparse_error(r->est, n) ||
-			(r->npasses == 1 && !r->radiosity && !r->focal &&
-			 plan_edge_error(r->est, n));
+		const unsigned where = plan_error_where(r->est, (size_t)r->w * r->h);
+		*memo = (where & PLAN_ERROR_FEW) ||
+			(r->npasses == 1 && !r->radiosity && !r->focal && (where & PLAN_ERROR_EDGES));
 	}
 	return *memo;
 }

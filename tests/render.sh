@@ -341,6 +341,16 @@ auto_and_scale() {
 			bad "$(basename "$2" .pov), --sampler $m: render failed"
 	done
 }
+# auto_beats_scale TAG SCENE REF FACTOR WHAT: check WHAT, that auto_and_scale
+# TAG SCENE's relMSE against REF with auto is at most FACTOR times scale's
+# (both printed)
+auto_beats_scale() {
+	local au sc
+	au=$(relmse "$T/$1-auto.exr" "$3")
+	sc=$(relmse "$T/$1-scale.exr" "$3")
+	echo "# $(basename "$2" .pov) 160x120 --target 3e-3: relMSE $au with --sampler auto, $sc with scale"
+	check "$5" num "a <= $4 * b" "$au" "$sc"
+}
 scene="$SC/hdr_highlights.pov"
 if ref=$(W=160 H=120 reference "$scene"); then
 	auto_and_scale hl "$scene"
@@ -352,12 +362,9 @@ if ref=$(W=160 H=120 reference "$scene"); then
 	check "... and says so" grep -q "error sits in few pixels" "$T/hl-auto.log"
 	check "--sampler scale: no antialiased region" \
 		test -z "$(compgen -G "$T/hl-scale.exr.work/p*-aa.exr")"
-	au=$(relmse "$T/hl-auto.exr" "$ref")
-	sc=$(relmse "$T/hl-scale.exr" "$ref")
-	echo "# hdr_highlights 160x120 --target 3e-3: relMSE $au with --sampler auto, $sc with scale"
 	# (measured 3.3e-4 against 1.8e-3; a weight of 1 for the antialiased
 	# render, as --sampler aa gives a pixel with no spread, ended at 6.7e-4)
-	check "highlights: relMSE at most half of scale 2's" num 'a <= 0.5 * b' "$au" "$sc"
+	auto_beats_scale hl "$scene" "$ref" 0.5 "highlights: relMSE at most half of scale 2's"
 else
 	bad "hdr_highlights: reference render failed"
 fi
@@ -372,10 +379,7 @@ if ref=$(S=9 W=160 H=120 reference "$scene"); then
 	check "still_life: the first pass renders antialiased regions in scale 2's place" \
 		test -n "$(compgen -G "$T/sl-auto.exr.work/p01-*-aa.exr")"
 	check "... and says why" grep -q "error sits in few pixels or at edges" "$T/sl-auto.log"
-	au=$(relmse "$T/sl-auto.exr" "$ref")
-	sc=$(relmse "$T/sl-scale.exr" "$ref")
-	echo "# still_life 160x120 --target 3e-3: relMSE $au with --sampler auto, $sc with scale"
-	check "still_life: relMSE at most a quarter of scale 2's" num 'a <= 0.25 * b' "$au" "$sc"
+	auto_beats_scale sl "$scene" "$ref" 0.25 "still_life: relMSE at most a quarter of scale 2's"
 else
 	bad "still_life: reference render failed"
 fi
