@@ -183,12 +183,18 @@ static double worth_samples(const struct accum_worth *w)
 /* Pixel (x, y)'s value in an antialiased render f times the image's size
  * (1, or ACC_GRID_FRAME in scale 2's place): the mean of its f x f render
  * pixels, into mean, and, if var is not NULL, that mean's variance (their
- * sample variance over f^2; 0 for f = 1); 0 if one is not finite. */
+ * sample variance over f^2; 0 for f = 1) and into *range their colour
+ * distance as POV-Ray measures it for its threshold (each channel's
+ * largest less smallest, summed); 0 if one is not finite. */
 static int aa_pixel(const struct image *img, int oy, const int ch[3], int f, int x, int y,
-		    double mean[3], double var[3])
+		    double mean[3], double var[3], double *range)
 {
 	int ok = 1;
-	double sq[3] = { 0.0, 0.0, 0.0 };
+	double sq[3] = { 0.0, 0.0, 0.0 }, lo[3], hi[3];
+	for (int c = 0; c < 3; c++) {
+		lo[c] = INFINITY;
+		hi[c] = -INFINITY;
+	}
 	for (int c = 0; c < 3; c++)
 		mean[c] = 0.0;
 	for (int j = 0; j < f; j++)
@@ -199,13 +205,17 @@ static int aa_pixel(const struct image *img, int oy, const int ch[3], int f, int
 				mean[c] += p[ch[c]] / (double)(f * f);
 				sq[c] += (double)p[ch[c]] * p[ch[c]] / (double)(f * f);
 				ok &= isfinite(p[ch[c]]) != 0;
+				lo[c] = p[ch[c]] < lo[c] ? p[ch[c]] : lo[c];
+				hi[c] = p[ch[c]] > hi[c] ? p[ch[c]] : hi[c];
 			}
 		}
-	if (var)	/* the f x f pixels' sample variance over f^2 */
+	if (var) {	/* the f x f pixels' sample variance over f^2 */
 		for (int c = 0; c < 3; c++) {
 			double v = f > 1 ? (sq[c] - mean[c] * mean[c]) / (f * f - 1) : 0.0;
 			var[c] = v > 0.0 ? v : 0.0;
 		}
+		*range = (hi[0] - lo[0]) + (hi[1] - lo[1]) + (hi[2] - lo[2]);
+	}
 	return ok;
 }
 
@@ -218,15 +228,28 @@ static int aa_worth(const struct image *acc, const struct image *img, int oy, co
 	for (int y = y0; y <= y1; y++)
 		for (int x = x0; x <= x1; x++) {
 			double mean[3];
-			aa_pixel(img, oy, ch, f, x, y, mean, NULL);
+			aa_pixel(img, oy, ch, f, x, y, mean, NULL, NULL);
 			worth_add(acc, (size_t)y * acc->w + x, ACC_AA, mean, &w);
 		}
 	return (int)lround(worth_samples(&w));
 }
 
-/* Fold an antialiased render f times the image's size (see aa_worth()). */
+/* What the spread of a pixel's render pixels is divided by for the error
+ * of their mean, in a render taken for edges whose render pixels' colour
+ * distance is range (see ACC_AA_EDGE). */
+static double edge_cells(double range)
+{
+	const double lo = ACC_AA_THRESHOLD / 10.0;
+	if (!(range > lo))
+		return 1.0;
+	return range >= ACC_AA_THRESHOLD ? ACC_AA_EDGE_CELLS
+					 : pow(ACC_AA_EDGE_CELLS, log10(range / lo));
+}
+
+/* Fold an antialiased render f times the image's size (see aa_worth()),
+ * in scale 2's place taken for edges if edges (ACC_AA_EDGE). */
 static long merge_aa(struct image *acc, const struct image *img, int oy, const int ch[3],
-		     int f, int x0, int y0, int x1, int y1, int pass)
+		     int f, int x0, int y0, int x1, int y1, int pass, int edges)
 {
 	int n = aa_worth(acc, img, oy, ch, f, x0, y0, x1, y1);
 	long count = 0;
@@ -235,8 +258,8 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			size_t i = (size_t)y * acc->w + x;
 			const float *o = acc->px + i * ACC_NCH;
 			double mean[3], old[3], m2[3] = { 0.0, 0.0, 0.0 };
-			double v[3];
-			int ok = aa_pixel(img, oy, ch, f, x, y, mean, v);
+			double v[3], range = 0.0;
+			int ok = aa_pixel(img, oy, ch, f, x, y, mean, v, &range);
 			for (int c = 0; c < 3; c++)
 				old[c] = o[c];
 			if (!ok) {
@@ -248,13 +271,16 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			 * pixel's spread is small would be weighted as the region's
 			 * noisier pixels prove it worth).  A pixel with no spread
 			 * to weigh it by (the base pass's one sample) takes it as
-			 * ACC_AA_FIRST samples */
+			 * ACC_AA_FIRST samples, or taken for edges as
+			 * ACC_AA_EDGE_CELLS */
 			struct accum_worth one = {0};
 			worth_add(acc, i, ACC_AA, mean, &one);
 			double own = worth_samples(&one);
 			const int half = f == ACC_GRID_FRAME;	/* in scale 2's place */
 			const int first = half && !(o[ACC_SAMPLES] >= 2.0f);
-			int k = first ? ACC_AA_FIRST : own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
+			const int edge = half && edges;
+			int k = first ? (edge ? ACC_AA_EDGE_CELLS : ACC_AA_FIRST)
+				      : own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
 			for (int c = 0; c < 3; c++)
 				m2[c] = k > 1 ? (double)o[ACC_VAR_R + c] * (k - 1) : 0.0;
 			double na = o[ACC_SAMPLES], prev = o[ACC_DIFF];
@@ -264,10 +290,20 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			/* in scale 2's place the render stands in for scale 2: the
 			 * planner moves on to scale 4 (a pixel planned at scale 2
 			 * again would get no new render: its jitter is the same
-			 * every run), and ACC_AA_HALF marks it for finest_scale() */
-			if (half)
-				acc->px[i * ACC_NCH + ACC_SCALES] =
-					(float)(scale_mask(acc, i) | 1u << 2 | 1u << ACC_AA_HALF);
+			 * every run), and ACC_AA_HALF marks it for finest_scale(),
+			 * ACC_AA_NOGRID for grid_pixel() where it had no scale 2,
+			 * ACC_AA_EDGE and ACC_AA_DEEP for hidden_edge() */
+			if (half) {
+				const uint32_t m = scale_mask(acc, i);
+				uint32_t add = 1u << 2 | 1u << ACC_AA_HALF;
+				if (!(m >> 2 & 1u))
+					add |= 1u << ACC_AA_NOGRID;
+				if (edge)
+					add |= 1u << ACC_AA_EDGE;
+				if (edge && range >= ACC_AA_THRESHOLD)
+					add |= 1u << ACC_AA_DEEP;
+				acc->px[i * ACC_NCH + ACC_SCALES] = (float)(m | add);
+			}
 			if (!(na > 0.0))
 				continue;
 			/* the error of the new mean, not knowing which of the two
@@ -294,9 +330,11 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			 * estimate at 160x120 stood at over 100 times the truth
 			 * and arealit3's (Debian's) at 320x240 at 55 times, and a
 			 * run at --target 1e-3 took a second pass that bought
-			 * nothing (2.8e-5 in 35 CPU s against 2.6e-5 in 9 s). */
+			 * nothing (2.8e-5 in 35 CPU s against 2.6e-5 in 9 s).
+			 * Taken for edges, the spread is over the cells the render
+			 * pixels stand for (edge_cells()). */
 			if (first) {
-				double rv = rel3(o, v);
+				double rv = rel3(o, v) / (edge ? edge_cells(range) : 1.0);
 				if (isfinite(rv) && rv < diff)
 					diff = rv;
 			}
@@ -442,8 +480,13 @@ static int grid_pixel(const struct image *acc, const struct image *img, int oy, 
 	const float *o = acc->px + i * ACC_NCH;
 	int nq = 0;
 	/* a sub-pixel's centre sample repeats scale 2's where the pixel has
-	 * it: taken out, by the pixel's mean in its place */
-	const int dup = accum_has_scale(acc, i, 2) && o[ACC_SAMPLES] > 0.0f;
+	 * it: taken out, by the pixel's mean in its place.  Not where scale
+	 * 2's bit stands for an antialiased render alone (ACC_AA_NOGRID): its
+	 * samples are at corners, none at those centres, and taking the mean
+	 * out would bias the fold by a quarter of the centres' difference
+	 * from it, at an edge a large one */
+	const int dup = accum_has_scale(acc, i, 2) && !accum_has_scale(acc, i, ACC_AA_NOGRID) &&
+			o[ACC_SAMPLES] > 0.0f;
 	*g = dup ? g0 - 1 : g0;
 	for (int c = 0; c < 3; c++)
 		mean[c] = 0.0;
@@ -558,9 +601,9 @@ static int scaled_pixel(const struct image *img, int oy, const int ch[3], int s,
 	return n;
 }
 
-int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
-		       int y0, int x1, int y1, int pass, long *folded, char *err,
-		       size_t errlen)
+static int merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
+			int y0, int x1, int y1, int pass, int edges, long *folded, char *err,
+			size_t errlen)
 {
 	if (folded)
 		*folded = 0;
@@ -599,7 +642,7 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 	}
 	const int ch[3] = { ir, ig, ib };
 	if (s == ACC_AA || grid) {
-		long c = s == ACC_AA ? merge_aa(acc, img, oy, ch, f, x0, y0, x1, y1, pass)
+		long c = s == ACC_AA ? merge_aa(acc, img, oy, ch, f, x0, y0, x1, y1, pass, edges)
 				     : merge_grid(acc, img, oy, ch, s, x0, y0, x1, y1, pass);
 		if (folded)
 			*folded = c;
@@ -629,8 +672,22 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 	return 0;
 }
 
-int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
-		     int y1, int pass, long *folded, char *err, size_t errlen)
+int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
+		       int y0, int x1, int y1, int pass, long *folded, char *err,
+		       size_t errlen)
+{
+	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, 0, folded, err, errlen);
+}
+
+int accum_merge_edge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
+			    int y0, int x1, int y1, int pass, long *folded, char *err,
+			    size_t errlen)
+{
+	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, 1, folded, err, errlen);
+}
+
+static int merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
+		      int y1, int pass, int edges, long *folded, char *err, size_t errlen)
 {
 	struct image img = {0};
 	int oy = 0;
@@ -643,23 +700,36 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 		f = render_frame(s, w, acc->w);
 	}
 	int rc = image_read_exr_rows(path, y0 * f, (y1 + 1) * f - 1, &img, &oy, err, errlen) ||
-		 accum_merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, folded, err, errlen);
+		 merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, edges, folded, err, errlen);
 	image_release(&img);
 	return rc ? -1 : 0;
+}
+
+int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
+		     int y1, int pass, long *folded, char *err, size_t errlen)
+{
+	return merge_file(acc, path, s, x0, y0, x1, y1, pass, 0, folded, err, errlen);
+}
+
+int accum_merge_edge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
+			  int y1, int pass, long *folded, char *err, size_t errlen)
+{
+	return merge_file(acc, path, s, x0, y0, x1, y1, pass, 1, folded, err, errlen);
 }
 
 /* The finest scale pixel i has been sampled at; an antialiased render of
  * --sampler aa (+A0, subdividing to 1/16 of a pixel where corners differ at
  * all) counts as 8.  In scale 2's place (+A0.1, ACC_AA_HALF) it counts as 2:
  * where the corners differ by less than the threshold its samples are half
- * a pixel apart. */
+ * a pixel apart; where it subdivided, taken for edges (ACC_AA_DEEP), as 8. */
 static int finest_scale(const struct image *acc, size_t i)
 {
 	int best = 1;
 	for (int k = 0; k < ACC_NSCALES; k++)
 		if (accum_has_scale(acc, i, accum_scales[k]))
 			best = accum_scales[k];
-	if (accum_has_scale(acc, i, ACC_AA) && !accum_has_scale(acc, i, ACC_AA_HALF) && best < 8)
+	if (accum_has_scale(acc, i, ACC_AA) && best < 8 &&
+	    (!accum_has_scale(acc, i, ACC_AA_HALF) || accum_has_scale(acc, i, ACC_AA_DEEP)))
 		best = 8;
 	return best;
 }
@@ -694,8 +764,13 @@ static int neighbours8(const struct image *acc, size_t i, const float *q[8])
  * its true relMSE, 1.9 with the weight, the dark pixels beside its lamps
  * near 1 each; the plans of nine scenes at targets 3e-3 to 3e-4 took 0 to
  * 24% fewer samples to errors from 3% lower to 11% higher, a fixed cost
- * model and one job making them deterministic.)  The largest over the
- * eight neighbours, mean over R, G, B.
+ * model and one job making them deterministic.)  Between two pixels of
+ * an antialiased render taken for edges (ACC_AA_EDGE) the part hidden is
+ * at most the render's threshold over the channels (ACC_AA_THRESHOLD / 3
+ * each): where their shared corners differed by more, POV-Ray subdivided
+ * (uncapped, the term held 0.9 of still_life's estimate after that pass,
+ * 7.8e-4 for a true relMSE of 1.6e-5; capped, 5e-5).  The largest over
+ * the eight neighbours, mean over R, G, B.
  */
 static double hidden_edge(const struct image *acc, size_t i, int s)
 {
@@ -707,6 +782,11 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 		if (!(q[ACC_SAMPLES] > 0.0f))
 			continue;
 		const int theirs = q[ACC_SAMPLES] >= 4.0f;
+		/* two pixels of a render taken for edges: their corners
+		 * between them differed by less than the threshold, or POV-Ray
+		 * subdivided there (ACC_AA_EDGE) */
+		const int seen = accum_has_scale(acc, i, ACC_AA_EDGE) &&
+				 accum_has_scale(acc, (size_t)(q - acc->px) / ACC_NCH, ACC_AA_EDGE);
 		double e = 0.0;
 		for (int c = 0; c < 3; c++) {
 			double d = (double)q[c] - o[c], v = o[c];
@@ -715,6 +795,8 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 			if (!(h2 > 0.0))
 				continue;
 			double dh = d > 0.0 ? sqrt(h2) : -sqrt(h2);
+			if (seen && fabs(dh) > ACC_AA_THRESHOLD / 3.0)
+				dh = d > 0.0 ? ACC_AA_THRESHOLD / 3.0 : -ACC_AA_THRESHOLD / 3.0;
 			for (int k = 0; k < 4; k++) {
 				double m = (k + 0.5) / (8.0 * s) * dh;
 				e += m * m / ((v + m) * (v + m) + METRICS_RELMSE_EPS) / 12.0;

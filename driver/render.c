@@ -1462,13 +1462,17 @@ static int has_scale2(const struct plan *pl)
  * solution's) nor focal blur (where antialiasing's samples are worth a
  * quarter of scaling's), at edges (plan_error_where()).  A pass may ask
  * twice (one_step(), choose_samplers()): a sort of w*h values, so kept in
- * *memo (-1 until asked) for the pass. */
+ * *memo (-1 until asked) for the pass: SPARSE_FEW, SPARSE_EDGES (at edges
+ * and not in a few pixels: the pass's antialiased renders are folded as
+ * taken for edges, accum_merge_edge_file()) or 0. */
+enum { SPARSE_FEW = 1, SPARSE_EDGES = 2 };
 static int sparse_error(const struct run *r, int *memo)
 {
 	if (*memo < 0) {
 		const unsigned where = plan_error_where(r->est, (size_t)r->w * r->h);
-		*memo = (where & PLAN_ERROR_FEW) ||
-			(r->npasses == 1 && !r->radiosity && !r->focal && (where & PLAN_ERROR_EDGES));
+		*memo = where & PLAN_ERROR_FEW ? SPARSE_FEW
+			: r->npasses == 1 && !r->radiosity && !r->focal && (where & PLAN_ERROR_EDGES)
+			? SPARSE_EDGES : 0;
 	}
 	return *memo;
 }
@@ -1781,8 +1785,10 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			continue;
 		}
 		long folded = 0;
-		if (accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1, pass,
-				     &folded, err, errlen)) {
+		const int edges = s == ACC_AA && g->frame == ACC_GRID_FRAME && sparse == SPARSE_EDGES;
+		if ((edges ? accum_merge_edge_file : accum_merge_file)(&r->acc, outs[k], s, g->x0,
+								       g->y0, g->x1, g->y1, pass,
+								       &folded, err, errlen)) {
 			fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n", pass,
 				g->x0, g->y0, g->x1, g->y1, err);
 			p.failed++;

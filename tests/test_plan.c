@@ -771,6 +771,136 @@ static void test_merge_aa(void **state)
 	image_release(&acc);
 }
 
+/* The cells an edge render's spread is divided over (ACC_AA_EDGE), as the
+ * header gives them: 1 up to a tenth of the threshold, ACC_AA_EDGE_CELLS
+ * from it, geometric between. */
+static double edge_cells_want(double range)
+{
+	if (range <= ACC_AA_THRESHOLD / 10.0)
+		return 1.0;
+	if (range >= ACC_AA_THRESHOLD)
+		return ACC_AA_EDGE_CELLS;
+	return pow(ACC_AA_EDGE_CELLS, log10(range / (ACC_AA_THRESHOLD / 10.0)));
+}
+
+/* 3c. An antialiased render in scale 2's place taken for edges: over a
+ * pixel's one sample it counts as ACC_AA_EDGE_CELLS samples, its fold is
+ * charged its 2 x 2 spread over the cells their colour distance says
+ * POV-Ray subdivided into, the pixels are marked (edge; subdivided where
+ * the distance reaches the threshold); a later grid render takes none of
+ * its samples out as scale 2's repeats; and between two such pixels no
+ * hidden edge is larger than the threshold. */
+static void test_merge_aa_edges(void **state)
+{
+	struct image acc, big, plain;
+	char err[256];
+	long folded = -1;
+	/* per pixel of row 0, the spread of its 2 x 2 render pixels in each
+	 * channel: colour distances 0, 0.03, 0.06, 0.3 and 0.9 */
+	const double spread[5] = { 0.0, 0.01, 0.02, 0.1, 0.3 };
+	const double pat[4] = { -0.5, 0.5, 0.5, -0.5 };	/* TL, TR, BL, BR */
+
+	(void)state;
+	assert_int_equal(image_init(&big, 10, 2, 3, rgb_names, err, sizeof(err)), 0);
+	for (int X = 0; X < 10; X++)
+		for (int Y = 0; Y < 2; Y++)
+			for (int c = 0; c < 3; c++)
+				big.px[((size_t)Y * 10 + X) * 3 + c] =
+					(float)(0.4 + 0.1 * c + spread[X / 2] * pat[Y * 2 + X % 2]);
+	make_acc(&acc, 5, 1, flat_value);
+	make_acc(&plain, 5, 1, flat_value);
+	assert_int_equal(accum_merge_edge_region(&acc, &big, 0, ACC_AA, 0, 0, 4, 0, 1, &folded,
+						 err, sizeof(err)), 0);
+	assert_int_equal(folded, 5);
+	assert_int_equal(accum_merge_region(&plain, &big, 0, ACC_AA, 0, 0, 4, 0, 1, &folded, err,
+					    sizeof(err)), 0);
+	for (int x = 0; x < 5; x++) {
+		const float *o = accpx(&acc, (size_t)x), *q = accpx(&plain, (size_t)x);
+		const double range = 3.0 * spread[x];
+		assert_true(o[ACC_SAMPLES] == (float)(1 + ACC_AA_EDGE_CELLS));
+		assert_true(q[ACC_SAMPLES] == (float)(1 + ACC_AA_FIRST));
+		double d = 0.0, v = 0.0;
+		for (int c = 0; c < 3; c++) {
+			const double m = 0.4 + 0.1 * c;	/* the 2 x 2 mean */
+			assert_close(o[c], (0.5 + ACC_AA_EDGE_CELLS * m) / (1 + ACC_AA_EDGE_CELLS),
+				     1e-6, 0.0, "the base sample and the mean, 1 to the cells");
+			const double den = (double)o[c] * o[c] + METRICS_RELMSE_EPS;
+			d += (m - 0.5) * (m - 0.5) / den / 3.0;
+			/* four values +-spread/2: variance spread^2/3, over 4 */
+			v += spread[x] * spread[x] / 3.0 / 4.0 / den / 3.0;
+		}
+		const double w = ACC_AA_EDGE_CELLS, full = (w * w + 1.0) / ((1.0 + w) * (1.0 + w)) * d;
+		const double bound = v / edge_cells_want(range);
+		assert_close(o[ACC_DIFF], full < bound ? full : bound, 1e-4, 1e-12,
+			     "the edge fold's error: the spread over its cells");
+		if (x >= 3)	/* the bound acts where the pixel differs */
+			assert_true(o[ACC_DIFF] < full);
+		if (x == 2)	/* between a tenth of the threshold and it */
+			assert_true(edge_cells_want(range) > 1.0 &&
+				    edge_cells_want(range) < ACC_AA_EDGE_CELLS);
+		assert_true(accum_has_scale(&acc, (size_t)x, ACC_AA_HALF));
+		assert_true(accum_has_scale(&acc, (size_t)x, ACC_AA_NOGRID));
+		assert_true(accum_has_scale(&acc, (size_t)x, ACC_AA_EDGE));
+		assert_int_equal(accum_has_scale(&acc, (size_t)x, ACC_AA_DEEP),
+				 range >= ACC_AA_THRESHOLD);
+		assert_false(accum_has_scale(&plain, (size_t)x, ACC_AA_EDGE));
+		assert_false(accum_has_scale(&plain, (size_t)x, ACC_AA_DEEP));
+		assert_true(accum_has_scale(&plain, (size_t)x, ACC_AA_NOGRID));
+	}
+	image_release(&plain);
+
+	/* hidden edges: pixel 0 beside a pixel 0.6 brighter, with 8
+	 * samples and no spread each; as edge pixels the difference that
+	 * counts is at most the threshold / 3 */
+	struct image two;
+	make_acc(&two, 2, 1, flat_value);
+	double e[2];
+	for (int k = 0; k < 2; k++) {
+		for (int x = 0; x < 2; x++) {
+			float *o = accpx(&two, (size_t)x);
+			for (int c = 0; c < 3; c++) {
+				o[c] = (float)(0.2 + 0.6 * x);
+				o[ACC_VAR_R + c] = 0.0f;
+			}
+			o[ACC_SAMPLES] = 8.0f;
+			o[ACC_SCALES] = (float)(1u << 1 | 1u << 2 | 1u << ACC_AA | 1u << ACC_AA_HALF |
+						(k ? 1u << ACC_AA_EDGE : 0u));
+		}
+		e[k] = accum_pixel_error(&two, 0, NAN, NULL, 0.0);
+	}
+	double cap = 0.0;	/* hidden_edge()'s sum with |d| at the cap, scale 2 */
+	for (int c = 0; c < 3; c++)
+		for (int k = 0; k < 4; k++) {
+			double m = (k + 0.5) / 16.0 * (ACC_AA_THRESHOLD / 3.0);
+			cap += m * m / ((0.2 + m) * (0.2 + m) + METRICS_RELMSE_EPS) / 12.0;
+		}
+	cap *= 0.5;	/* on this pixel's side: 2 / (2 + 2) */
+	assert_true(e[0] > 10.0 * e[1]);
+	assert_close(e[1], cap, 1e-6, 1e-15, "the hidden edge at most the threshold");
+	image_release(&two);
+
+	/* a grid render of scale 4 over them: all 4 x 5 samples new (the
+	 * render had none at the sub-pixel centres); over a pixel that has
+	 * had scale 2 itself, 4 x 4 (each sub-pixel's centre sample is a
+	 * repeat) */
+	accpx(&acc, 4)[ACC_SCALES] = (float)(1u << 1 | 1u << 2);
+	accpx(&acc, 4)[ACC_SAMPLES] = 5.0f;
+	make_render(&plain, 10, 0, 2, 4);
+	float before[5];
+	for (int x = 0; x < 5; x++)
+		before[x] = accpx(&acc, (size_t)x)[ACC_SAMPLES];
+	assert_int_equal(accum_merge_region(&acc, &plain, 0, 4, 0, 0, 4, 0, 2, &folded, err,
+					    sizeof(err)), 0);
+	assert_int_equal(folded, 5);
+	const int g = accum_grid_samples(4);
+	for (int x = 0; x < 5; x++)
+		assert_true(accpx(&acc, (size_t)x)[ACC_SAMPLES] ==
+			    before[x] + (float)(x < 4 ? g : g - 4));
+	image_release(&plain);
+	image_release(&big);
+	image_release(&acc);
+}
+
 /* 4. accum_read round-trips an accumulation; a missing channel is named. */
 static void test_accum_read(void **state)
 {
@@ -1825,6 +1955,7 @@ int main(void)
 		cmocka_unit_test(test_merge_region),
 		cmocka_unit_test(test_merge_nonfinite),
 		cmocka_unit_test(test_merge_aa),
+		cmocka_unit_test(test_merge_aa_edges),
 		cmocka_unit_test(test_merge_grid),
 		cmocka_unit_test(test_merge_stratified),
 		cmocka_unit_test(test_accum_read),
