@@ -192,11 +192,10 @@ static int aa_pixel(const struct image *img, int oy, const int ch[3], int f, int
 	int ok = 1;
 	double sq[3] = { 0.0, 0.0, 0.0 }, lo[3], hi[3];
 	for (int c = 0; c < 3; c++) {
+		mean[c] = 0.0;
 		lo[c] = INFINITY;
 		hi[c] = -INFINITY;
 	}
-	for (int c = 0; c < 3; c++)
-		mean[c] = 0.0;
 	for (int j = 0; j < f; j++)
 		for (int l = 0; l < f; l++) {
 			const float *p = img->px + ((size_t)(y * f + j - oy) * img->w +
@@ -782,11 +781,12 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 		if (!(q[ACC_SAMPLES] > 0.0f))
 			continue;
 		const int theirs = q[ACC_SAMPLES] >= 4.0f;
+		const size_t qi = (size_t)(q - acc->px) / ACC_NCH;
 		/* two pixels of a render taken for edges: their corners
 		 * between them differed by less than the threshold, or POV-Ray
 		 * subdivided there (ACC_AA_EDGE) */
 		const int seen = accum_has_scale(acc, i, ACC_AA_EDGE) &&
-				 accum_has_scale(acc, (size_t)(q - acc->px) / ACC_NCH, ACC_AA_EDGE);
+				 accum_has_scale(acc, qi, ACC_AA_EDGE);
 		double e = 0.0;
 		for (int c = 0; c < 3; c++) {
 			double d = (double)q[c] - o[c], v = o[c];
@@ -807,7 +807,7 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 		/* the edge lies in the gap between the two pixels' samples, our
 		 * strip 1/(2s) wide and theirs 1/(2 s_j): on our side with
 		 * probability s_j / (s + s_j) */
-		const int sj = finest_scale(acc, (size_t)(q - acc->px) / ACC_NCH);
+		const int sj = finest_scale(acc, qi);
 		e *= (double)sj / (s + sj);
 		if (e > best)
 			best = e;
