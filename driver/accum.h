@@ -84,27 +84,42 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * subdivided (its f x f render pixels differ by POV-Ray's threshold,
  * ACC_AA_THRESHOLD, or more).  At an edge the render's corners are half
  * a pixel apart and where they differ by the threshold POV-Ray
- * subdivides, to 1/8 of a pixel at +R3 in the twice-size frame: the pixel
- * is ACC_AA_EDGE_CELLS cells' mean (2 x 2 render pixels of 4 x 4), and the
- * base pass's one sample at its centre adds nothing the corners lack.
- * Such a pixel takes the render as ACC_AA_EDGE_CELLS samples over that
- * one (not ACC_AA_FIRST), its fold is charged its render pixels' spread
- * over the cells it stands for, a subdivided one counts as scale 8 for
+ * subdivides, to 1/16 of a pixel at +R4 (ACC_AA_EDGE_DEPTH; +R3 where a
+ * budget leaves too little time, render.c's edge_depth()) in the
+ * twice-size frame: the pixel is accum_edge_cells(depth) cells' mean (at
+ * +R4 2 x 2 render pixels of 8 x 8), and the base pass's one sample at its
+ * centre adds nothing the corners lack.  Such a pixel takes the render as
+ * that many samples over that one (not ACC_AA_FIRST), their variance the
+ * render pixels', its fold is charged their spread over the cells it
+ * stands for, a subdivided one counts as scale 8 for
  * the hidden-edge term, and between two such pixels no hidden edge can be
  * larger than the threshold.  Measured against references (scratch
- * script): after the base and edge passes at 160x120, over pixels whose
- * render pixels differ by 0.1 or more the true squared error was 1/102
+ * script): after the base and edge passes at 160x120 with the render at
+ * +R3 (4 x 4 cells a render pixel, 64 a pixel), over pixels whose render
+ * pixels differ by 0.1 or more the true squared error was 1/102
  * (still_life), 1/35 (Debian's lights/arealit3) and 1/54 (advanced/
  * lamppost) of that spread; by 0.01 to 0.1 about 1/10 to 1/1, so the
- * division ramps in log from 1 at ACC_AA_THRESHOLD / 10 to 64 at the
- * threshold.  Not for the few-pixels rule's renders (starfield's stars,
- * hdr_highlights' lamps): a star between corners goes unseen, the base
- * sample may hold it, and there the same folding stopped starfield at
- * --target 3e-3 at relMSE 9.0e-3 on an estimate of 1.7e-4.
+ * division ramps in log from 1 at ACC_AA_THRESHOLD / 10 to the cells at
+ * the threshold.  At +R4 the edges' error fell to a quarter (still_life at
+ * --target 3e-3: relMSE 1.56e-5 to 4.5e-6, its subdivided pixels' share
+ * 1.2e-5 to 2.9e-6, for 1.3 to 1.6 CPU s), as halving the cells' side
+ * should, and with 256 cells those pixels' estimate came out 1.5 times
+ * their true error.  Not for the few-pixels rule's renders (starfield's
+ * stars, hdr_highlights' lamps): a star between corners goes unseen, the
+ * base sample may hold it, and there the same folding stopped starfield
+ * at --target 3e-3 at relMSE 9.0e-3 on an estimate of 1.7e-4.
  */
 #define ACC_AA_EDGE 7
 #define ACC_AA_DEEP 8
-#define ACC_AA_EDGE_CELLS 64
+#define ACC_AA_EDGE_DEPTH 4
+
+/* The cells a pixel of such a render at POV-Ray's depth d stands for:
+ * 2 x 2 render pixels of 2^(d-1) x 2^(d-1) (64 at +R3, 256 at +R4). */
+static inline int accum_edge_cells(int d)
+{
+	return 1 << (2 * d);
+}
+#define ACC_AA_EDGE_CELLS (1 << (2 * ACC_AA_EDGE_DEPTH))
 #define ACC_AA_THRESHOLD 0.1
 
 /* A region render of scale s is accum_render_factor(s) times the image's
@@ -203,14 +218,16 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 		     int y1, int pass, long *folded, char *err, size_t errlen);
 
 /* accum_merge_region() and accum_merge_file() of an antialiased render in
- * scale 2's place (s ACC_AA, twice the image's size) taken for edges:
- * folded as ACC_AA_EDGE says.  Any other render is folded as by the
- * two. */
-int accum_merge_edge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
-			    int y0, int x1, int y1, int pass, long *folded, char *err,
-			    size_t errlen);
-int accum_merge_edge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
-			  int y1, int pass, long *folded, char *err, size_t errlen);
+ * scale 2's place (s ACC_AA, twice the image's size) taken for edges, at
+ * POV-Ray's depth `depth` (+R, 1 to ACC_AA_EDGE_DEPTH): folded as
+ * ACC_AA_EDGE says, over accum_edge_cells(depth) cells.  Any other render
+ * is folded as by the two. */
+int accum_merge_edge_region(struct image *acc, const struct image *img, int oy, int s,
+			    int depth, int x0, int y0, int x1, int y1, int pass, long *folded,
+			    char *err, size_t errlen);
+int accum_merge_edge_file(struct image *acc, const char *path, int s, int depth, int x0,
+			  int y0, int x1, int y1, int pass, long *folded, char *err,
+			  size_t errlen);
 
 /* What pixel i's relative errors are relative to: the mean over R, G, B
  * of value^2 + 0.01, the value being fit (the regression's, where finite;

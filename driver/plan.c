@@ -950,7 +950,9 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 		/* POV-Ray's own adaptive antialiasing, jittered (accum.h) */
 		extra[job->nextra++] = "+AM2";
 		extra[job->nextra++] = r->frame > 0 ? "+A0.1" : "+A0.0";
-		extra[job->nextra++] = r->frame > 0 ? "+R3" : "+R4";
+		static const char *const depth[] = { "+R3", "+R1", "+R2", "+R3", "+R4" };
+		extra[job->nextra++] = r->frame <= 0 ? "+R4"
+				       : depth[r->edges >= 1 && r->edges <= 4 ? r->edges : 0];
 		extra[job->nextra++] = "+J";
 	} else if (grid) {
 		/* every pixel of the render supersampled (accum.h) */

@@ -772,24 +772,26 @@ static void test_merge_aa(void **state)
 }
 
 /* The cells an edge render's spread is divided over (ACC_AA_EDGE), as the
- * header gives them: 1 up to a tenth of the threshold, ACC_AA_EDGE_CELLS
- * from it, geometric between. */
-static double edge_cells_want(double range)
+ * header gives them: 1 up to a tenth of the threshold, `cells` from it,
+ * geometric between. */
+static double edge_cells_want(double range, double cells)
 {
 	if (range <= ACC_AA_THRESHOLD / 10.0)
 		return 1.0;
 	if (range >= ACC_AA_THRESHOLD)
-		return ACC_AA_EDGE_CELLS;
-	return pow(ACC_AA_EDGE_CELLS, log10(range / (ACC_AA_THRESHOLD / 10.0)));
+		return cells;
+	return pow(cells, log10(range / (ACC_AA_THRESHOLD / 10.0)));
 }
 
-/* 3c. An antialiased render in scale 2's place taken for edges: over a
- * pixel's one sample it counts as ACC_AA_EDGE_CELLS samples, its fold is
- * charged its 2 x 2 spread over the cells their colour distance says
- * POV-Ray subdivided into, the pixels are marked (edge; subdivided where
- * the distance reaches the threshold); a later grid render takes none of
- * its samples out as scale 2's repeats; and between two such pixels no
- * hidden edge is larger than the threshold. */
+/* 3c. An antialiased render in scale 2's place taken for edges at depth
+ * d (4, ACC_AA_EDGE_DEPTH, and 3): over a pixel's one sample it counts as
+ * 4^d cells, whose variance is its 2 x 2 render pixels', its fold is
+ * charged their spread over the cells their colour distance says POV-Ray
+ * subdivided into, the pixels are marked (edge; subdivided where the
+ * distance reaches the threshold); a depth outside 1 to 4 is refused; a
+ * later grid render takes none of its samples out as scale 2's repeats;
+ * and between two such pixels no hidden edge is larger than the
+ * threshold. */
 static void test_merge_aa_edges(void **state)
 {
 	struct image acc, big, plain;
@@ -807,37 +809,47 @@ static void test_merge_aa_edges(void **state)
 			for (int c = 0; c < 3; c++)
 				big.px[((size_t)Y * 10 + X) * 3 + c] =
 					(float)(0.4 + 0.1 * c + spread[X / 2] * pat[Y * 2 + X % 2]);
-	make_acc(&acc, 5, 1, flat_value);
+	assert_int_equal(ACC_AA_EDGE_CELLS, accum_edge_cells(ACC_AA_EDGE_DEPTH));
+	assert_int_equal(accum_edge_cells(3), 64);
 	make_acc(&plain, 5, 1, flat_value);
-	assert_int_equal(accum_merge_edge_region(&acc, &big, 0, ACC_AA, 0, 0, 4, 0, 1, &folded,
-						 err, sizeof(err)), 0);
-	assert_int_equal(folded, 5);
 	assert_int_equal(accum_merge_region(&plain, &big, 0, ACC_AA, 0, 0, 4, 0, 1, &folded, err,
 					    sizeof(err)), 0);
+	for (int depth = 3; depth <= 4; depth++) {
+	make_acc(&acc, 5, 1, flat_value);
+	assert_int_equal(accum_merge_edge_region(&acc, &big, 0, ACC_AA, depth, 0, 0, 4, 0, 1,
+						 &folded, err, sizeof(err)), 0);
+	assert_int_equal(folded, 5);
+	const int cells = accum_edge_cells(depth);
 	for (int x = 0; x < 5; x++) {
 		const float *o = accpx(&acc, (size_t)x), *q = accpx(&plain, (size_t)x);
 		const double range = 3.0 * spread[x];
-		assert_true(o[ACC_SAMPLES] == (float)(1 + ACC_AA_EDGE_CELLS));
+		assert_true(o[ACC_SAMPLES] == (float)(1 + cells));
 		assert_true(q[ACC_SAMPLES] == (float)(1 + ACC_AA_FIRST));
 		double d = 0.0, v = 0.0;
 		for (int c = 0; c < 3; c++) {
 			const double m = 0.4 + 0.1 * c;	/* the 2 x 2 mean */
-			assert_close(o[c], (0.5 + ACC_AA_EDGE_CELLS * m) / (1 + ACC_AA_EDGE_CELLS),
-				     1e-6, 0.0, "the base sample and the mean, 1 to the cells");
+			assert_close(o[c], (0.5 + cells * m) / (1 + cells), 1e-6, 0.0,
+				     "the base sample and the mean, 1 to the cells");
 			const double den = (double)o[c] * o[c] + METRICS_RELMSE_EPS;
 			d += (m - 0.5) * (m - 0.5) / den / 3.0;
 			/* four values +-spread/2: variance spread^2/3, over 4 */
 			v += spread[x] * spread[x] / 3.0 / 4.0 / den / 3.0;
+			/* the cells vary as the render pixels, spread^2/3, and
+			 * the base sample 0.5 adds its difference */
+			const double m2 = spread[x] * spread[x] / 3.0 * (cells - 1) +
+					  (m - 0.5) * (m - 0.5) * cells / (1.0 + cells);
+			assert_close(o[ACC_VAR_R + c], m2 / cells, 1e-4, 1e-9,
+				     "the cells' variance: the render pixels'");
 		}
-		const double w = ACC_AA_EDGE_CELLS, full = (w * w + 1.0) / ((1.0 + w) * (1.0 + w)) * d;
-		const double bound = v / edge_cells_want(range);
+		const double w = cells, full = (w * w + 1.0) / ((1.0 + w) * (1.0 + w)) * d;
+		const double bound = v / edge_cells_want(range, cells);
 		assert_close(o[ACC_DIFF], full < bound ? full : bound, 1e-4, 1e-12,
 			     "the edge fold's error: the spread over its cells");
 		if (x >= 3)	/* the bound acts where the pixel differs */
 			assert_true(o[ACC_DIFF] < full);
 		if (x == 2)	/* between a tenth of the threshold and it */
-			assert_true(edge_cells_want(range) > 1.0 &&
-				    edge_cells_want(range) < ACC_AA_EDGE_CELLS);
+			assert_true(edge_cells_want(range, cells) > 1.0 &&
+				    edge_cells_want(range, cells) < cells);
 		assert_true(accum_has_scale(&acc, (size_t)x, ACC_AA_HALF));
 		assert_true(accum_has_scale(&acc, (size_t)x, ACC_AA_NOGRID));
 		assert_true(accum_has_scale(&acc, (size_t)x, ACC_AA_EDGE));
@@ -846,6 +858,15 @@ static void test_merge_aa_edges(void **state)
 		assert_false(accum_has_scale(&plain, (size_t)x, ACC_AA_EDGE));
 		assert_false(accum_has_scale(&plain, (size_t)x, ACC_AA_DEEP));
 		assert_true(accum_has_scale(&plain, (size_t)x, ACC_AA_NOGRID));
+	}
+	if (depth < ACC_AA_EDGE_DEPTH)
+		image_release(&acc);	/* the deepest goes on below */
+	}
+	for (int depth = 0; depth <= 5; depth += 5) {
+		err[0] = '\0';
+		assert_int_equal(accum_merge_edge_region(&acc, &big, 0, ACC_AA, depth, 0, 0, 4, 0, 2,
+							 &folded, err, sizeof(err)), -1);
+		assert_non_null(strstr(err, "depth"));
 	}
 	image_release(&plain);
 
@@ -1733,9 +1754,9 @@ static void test_edge_error(void **state)
 static void test_regions_file(void **state)
 {
 	struct plan_region rs[3] = {
-		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1, 0 },
-		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2, 0 },
-		{ 63, 47, 63, 47, 16, 1, 0.1, 0.3, 0 },
+		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1, 0, 0 },
+		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2, 0, 0 },
+		{ 63, 47, 63, 47, 16, 1, 0.1, 0.3, 0, 0 },
 	};
 	static char o0[] = "r0.exr", o1[] = "a dir/with spaces/region 1.exr",
 		o2[] = "/tmp/x y  z.exr";
@@ -1823,7 +1844,7 @@ static void test_plan_job(void **state)
 {
 	static const char *const base_extra[] = { "+Q9", "Antialias_Threshold=0.1" };
 	struct pov_job base, job;
-	struct plan_region r = { 3, 2, 10, 7, 4, 0, 0.0, 0.0, 0 };
+	struct plan_region r = { 3, 2, 10, 7, 4, 0, 0.0, 0.0, 0, 0 };
 	struct pov_region region;
 	const char *extra[3];
 
@@ -1863,6 +1884,16 @@ static void test_plan_job(void **state)
 	plan_job(&base, &r, "out/a1.exr", &region, aextra, &job);
 	assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
 	assert_aa_options(&job, "+AM2", "+A0.1", "+R3", "+J");
+	/* taken for edges: the depth it was given */
+	for (int d = 1; d <= ACC_AA_EDGE_DEPTH; d++) {
+		char want[8];
+		snprintf(want, sizeof(want), "+R%d", d);
+		r.edges = d;
+		plan_job(&base, &r, "out/a2.exr", &region, aextra, &job);
+		assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
+		assert_aa_options(&job, "+AM2", "+A0.1", want, "+J");
+	}
+	r.edges = 0;
 	r.frame = 0;
 	char name[64];
 	plan_output_name(name, sizeof(name), "w", 3, 7, ACC_AA);
