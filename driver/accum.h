@@ -89,9 +89,10 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * twice-size frame: the pixel is accum_edge_cells(depth) cells' mean (at
  * +R4 2 x 2 render pixels of 8 x 8), and the base pass's one sample at its
  * centre adds nothing the corners lack.  Such a pixel takes the render as
- * that many samples over that one (not ACC_AA_FIRST), their variance the
- * render pixels', its fold is charged their spread over the cells it
- * stands for, a subdivided one counts as scale 8 for
+ * that many samples over that one (not ACC_AA_FIRST; with less colour
+ * distance as the cells edge_cells() gives, at least ACC_AA_FIRST), their
+ * variance the render pixels', its fold is charged their spread over the
+ * cells it stands for, a subdivided one counts as scale 8 for
  * the hidden-edge term, and between two such pixels no hidden edge can be
  * larger than the threshold.  Measured against references (scratch
  * script): after the base and edge passes at 160x120 with the render at

@@ -785,7 +785,9 @@ static double edge_cells_want(double range, double cells)
 
 /* 3c. An antialiased render in scale 2's place taken for edges at depth
  * d (4, ACC_AA_EDGE_DEPTH, and 3): over a pixel's one sample it counts as
- * 4^d cells, whose variance is its 2 x 2 render pixels', its fold is
+ * the cells POV-Ray subdivided it into (4^d where its render pixels' colour
+ * distance reaches the threshold, at least ACC_AA_FIRST), whose variance
+ * is its 2 x 2 render pixels', its fold is
  * charged their spread over the cells their colour distance says POV-Ray
  * subdivided into, the pixels are marked (edge; subdivided where the
  * distance reaches the threshold); a depth outside 1 to 4 is refused; a
@@ -823,12 +825,18 @@ static void test_merge_aa_edges(void **state)
 	for (int x = 0; x < 5; x++) {
 		const float *o = accpx(&acc, (size_t)x), *q = accpx(&plain, (size_t)x);
 		const double range = 3.0 * spread[x];
-		assert_true(o[ACC_SAMPLES] == (float)(1 + cells));
+		/* the samples it stands for: the cells it was subdivided
+		 * into, at least ACC_AA_FIRST */
+		const double ek = edge_cells_want(range, cells);
+		const int k = ek > ACC_AA_FIRST ? (int)lround(ek) : ACC_AA_FIRST;
+		assert_true(o[ACC_SAMPLES] == (float)(1 + k));
+		if (range >= ACC_AA_THRESHOLD)
+			assert_int_equal(k, cells);
 		assert_true(q[ACC_SAMPLES] == (float)(1 + ACC_AA_FIRST));
 		double d = 0.0, v = 0.0;
 		for (int c = 0; c < 3; c++) {
 			const double m = 0.4 + 0.1 * c;	/* the 2 x 2 mean */
-			assert_close(o[c], (0.5 + cells * m) / (1 + cells), 1e-6, 0.0,
+			assert_close(o[c], (0.5 + k * m) / (1 + k), 1e-6, 0.0,
 				     "the base sample and the mean, 1 to the cells");
 			const double den = (double)o[c] * o[c] + METRICS_RELMSE_EPS;
 			d += (m - 0.5) * (m - 0.5) / den / 3.0;
@@ -836,12 +844,12 @@ static void test_merge_aa_edges(void **state)
 			v += spread[x] * spread[x] / 3.0 / 4.0 / den / 3.0;
 			/* the cells vary as the render pixels, spread^2/3, and
 			 * the base sample 0.5 adds its difference */
-			const double m2 = spread[x] * spread[x] / 3.0 * (cells - 1) +
-					  (m - 0.5) * (m - 0.5) * cells / (1.0 + cells);
-			assert_close(o[ACC_VAR_R + c], m2 / cells, 1e-4, 1e-9,
+			const double m2 = spread[x] * spread[x] / 3.0 * (k - 1) +
+					  (m - 0.5) * (m - 0.5) * k / (1.0 + k);
+			assert_close(o[ACC_VAR_R + c], m2 / k, 1e-4, 1e-9,
 				     "the cells' variance: the render pixels'");
 		}
-		const double w = cells, full = (w * w + 1.0) / ((1.0 + w) * (1.0 + w)) * d;
+		const double w = k, full = (w * w + 1.0) / ((1.0 + w) * (1.0 + w)) * d;
 		const double bound = v / edge_cells_want(range, cells);
 		assert_close(o[ACC_DIFF], full < bound ? full : bound, 1e-4, 1e-12,
 			     "the edge fold's error: the spread over its cells");
