@@ -85,7 +85,7 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * ACC_AA_THRESHOLD, or more).  At an edge the render's corners are half
  * a pixel apart and where they differ by the threshold POV-Ray
  * subdivides, to 1/16 of a pixel at +R4 (ACC_AA_EDGE_DEPTH; +R3 where a
- * budget leaves too little time, render.c's edge_depth()) in the
+ * budget leaves too little time, render.c's aa_depth()) in the
  * twice-size frame: the pixel is accum_edge_cells(depth) cells' mean (at
  * +R4 2 x 2 render pixels of 8 x 8), and the base pass's one sample at its
  * centre adds nothing the corners lack.  Such a pixel takes the render as
@@ -112,6 +112,9 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  */
 #define ACC_AA_EDGE 7
 #define ACC_AA_DEEP 8
+/* POV-Ray's depth for an antialiased render in scale 2's place, for edges
+ * or a few pixels alike (render.c's aa_depth(): +R3 under a budget that
+ * would not fit it) */
 #define ACC_AA_EDGE_DEPTH 4
 
 /* The cells a pixel of such a render at POV-Ray's depth d stands for:

@@ -952,7 +952,7 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 		extra[job->nextra++] = r->frame > 0 ? "+A0.1" : "+A0.0";
 		static const char *const depth[] = { "+R3", "+R1", "+R2", "+R3", "+R4" };
 		extra[job->nextra++] = r->frame <= 0 ? "+R4"
-				       : depth[r->edges >= 1 && r->edges <= 4 ? r->edges : 0];
+				       : depth[r->depth >= 1 && r->depth <= 4 ? r->depth : 0];
 		extra[job->nextra++] = "+J";
 	} else if (grid) {
 		/* every pixel of the render supersampled (accum.h) */

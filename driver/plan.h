@@ -102,11 +102,11 @@ struct plan_region {
 				 * scale ACC_AA, an antialiased render in scale
 				 * 2's place (+A0.1 +R3 rather than +A0.0 +R4;
 				 * render.c, choose_samplers()) */
+	int depth;		/* such a render's POV-Ray depth (+R, 1 to
+				 * ACC_AA_EDGE_DEPTH; 0 for +R3) */
 	int edges;		/* such a render taken for edges (render.c's
-				 * edge rule): POV-Ray's depth (+R, 1 to
-				 * ACC_AA_EDGE_DEPTH) rather than +R3, and
-				 * folded so (accum_merge_edge_file()); 0 for
-				 * any other */
+				 * edge rule), folded so
+				 * (accum_merge_edge_file()) */
 };
 
 /* Pixels in r. */
@@ -174,7 +174,7 @@ void plan_release(struct plan *pl);
  * (r->frame ACC_GRID_FRAME) at twice base with +AM1 +A0.0 +R(scale/2)
  * +J0.75; when r->scale is ACC_AA at scale 1 with POV-Ray's antialiasing,
  * +AM2 +A0.0 +R4 +J, or at twice the size (r->frame ACC_GRID_FRAME) with
- * +AM2 +A0.1 +R3 +J (+R(r->edges) where that is set) (the options
+ * +AM2 +A0.1 +R3 +J (+R(r->depth) where that is set) (the options
  * appended after the user's, which come from base->extra).
  * base gives the scene,
  * full size, threads, defines, extra options, work directory and binary;

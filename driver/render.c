@@ -113,10 +113,10 @@ static const char usage_options[] =
 	"                        holding half of it, as at highlights, or after the\n"
 	"                        base pass at edges, 5% of them holding two thirds\n"
 	"                        (not with radiosity or focal blur), scale 2 as\n"
-	"                        one render at twice the size\n"
-	"                        with POV-Ray's +AM2 +A0.1 +R3 +J (+R4 for edges);\n"
-	"                        where it is spread\n"
-	"                        and the frame at scale 4 takes less than 0.7 s on\n"
+	"                        one render at twice the size with POV-Ray's\n"
+	"                        +AM2 +A0.1 +R4 +J (+R3 where a budget would not\n"
+	"                        fit it); where it is spread and the frame at\n"
+	"                        scale 4 takes less than 0.7 s on\n"
 	"                        the cores, as jitter), grid\n"
 	"                        (scales 4, 8 and 16 as renders at twice the size with\n"
 	"                        POV-Ray's +AM1 +A0.0 +R(scale/2) +J0.75: scale x\n"
@@ -988,14 +988,15 @@ static int is_user_header(const char *a)
 }
 
 struct pre_kind {
-	int scale, frame, edges;
+	int scale, frame, depth, edges;
 };
 
 /* Whether region g is of kind k (frame 0 or ACC_GRID_FRAME alike; an
- * antialiased render taken for edges is deeper than one that is not). */
+ * antialiased render of the same depth, and for edges or not alike). */
 static int of_kind(const struct plan_region *g, struct pre_kind k)
 {
-	return g->scale == k.scale && (g->frame > 0) == (k.frame > 0) && g->edges == k.edges;
+	return g->scale == k.scale && (g->frame > 0) == (k.frame > 0) && g->depth == k.depth &&
+	       g->edges == k.edges;
 }
 
 /* The kind of plan pl's regions with the most pixels, their pixels in
@@ -1003,13 +1004,13 @@ static int of_kind(const struct plan_region *g, struct pre_kind k)
  * count in *n. */
 static struct pre_kind main_kind(const struct plan *pl, long *area, double *cost, int *n)
 {
-	struct pre_kind best = { 0, 0, 0 };
+	struct pre_kind best = { 0, 0, 0, 0 };
 	*area = 0;
 	*cost = 0.0;
 	*n = 0;
 	for (size_t k = 0; k < pl->nregions; k++) {
 		struct pre_kind kind = { pl->regions[k].scale, pl->regions[k].frame,
-					 pl->regions[k].edges };
+					 pl->regions[k].depth, pl->regions[k].edges };
 		long a = 0;
 		double c = 0.0;
 		int m = 0;
@@ -1095,6 +1096,7 @@ static void prelaunch_start(struct run *r, int pass, const struct pre_kind *kind
 			g->y1 = (int)((long)(b + 1) * r->h / nb) - 1;
 			g->scale = kinds[t].scale;
 			g->frame = kinds[t].frame;
+			g->depth = kinds[t].depth;
 			g->edges = kinds[t].edges;
 			plan_output_name(outs[n], sizeof outs[n], r->workdir, pass, n, g->scale);
 			plan_job(&base, g, outs[n], &regs[n], extras + n * (r->nextra + 4), &jobs[n]);
@@ -1233,11 +1235,11 @@ static void prelaunch_first(struct run *r)
 	struct pre_kind kinds[PRE_KINDS];
 	int nk = 0;
 	if (r->grid != PLAN_GRID_ONLY)
-		kinds[nk++] = (struct pre_kind){ 2, 0, 0 };
+		kinds[nk++] = (struct pre_kind){ 2, 0, 0, 0 };
 	if (r->grid != PLAN_GRID_NEVER && !r->focal)	/* one_step()'s jitter */
-		kinds[nk++] = (struct pre_kind){ 4, ACC_GRID_FRAME, 0 };
+		kinds[nk++] = (struct pre_kind){ 4, ACC_GRID_FRAME, 0, 0 };
 	if (r->grid == PLAN_GRID_LARGE && !r->aa)
-		kinds[nk++] = (struct pre_kind){ ACC_AA, ACC_GRID_FRAME, 0 };
+		kinds[nk++] = (struct pre_kind){ ACC_AA, ACC_GRID_FRAME, ACC_AA_EDGE_DEPTH, 0 };
 	prelaunch_start(r, 1, kinds, nk, r->cores);
 }
 
@@ -1255,7 +1257,7 @@ static void prelaunch_next(struct run *r, int pass, const struct plan *pl,
 		return;
 	struct plan_params next = *pp;
 	next.grid = run_grid(r);
-	struct pre_kind kind = { s, plan_grid_scale(&next, r->w, r->h, s) ? ACC_GRID_FRAME : 0, 0 };
+	struct pre_kind kind = { s, plan_grid_scale(&next, r->w, r->h, s) ? ACC_GRID_FRAME : 0, 0, 0 };
 	if (!kind.frame && (double)s * s * r->w * r->h > PLAN_MAX_FRAME)
 		return;	/* a frame no region render gets */
 	prelaunch_start(r, pass, &kind, 1, 2 * r->cores);
@@ -1485,8 +1487,9 @@ static int sparse_error(const struct run *r, int *memo)
  * The sampler of each region of a plan.  With --sampler auto, where the
  * error sits in a few pixels or at edges (sparse_error()), the regions of scale 2 are
  * rendered once at twice the image's size with POV-Ray's antialiasing,
- * +AM2 +A0.1 +R3 +J (frame ACC_GRID_FRAME; ACC_AA_FIRST for how they are folded;
- * at edges +R4, edge_depth(), folded as ACC_AA_EDGE says): it
+ * +AM2 +A0.1 +R4 +J (frame ACC_GRID_FRAME; +R3 under a budget it would not
+ * fit, aa_depth(); ACC_AA_FIRST for how they are folded, at edges
+ * ACC_AA_EDGE): it
  * subdivides only where corners differ, down to 1/16 of a pixel at a
  * highlight, where scale 2 gives every pixel of the rectangles 4 samples;
  * at twice the size its corners are scale 2's density where it does not
@@ -1523,18 +1526,20 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
 	for (size_t k = m; k < pl->nregions; k++) {
 		pl->regions[k].scale = ACC_AA;
 		pl->regions[k].frame = first ? ACC_GRID_FRAME : 0;
-		pl->regions[k].edges = first && *sparse == SPARSE_EDGES ? ACC_AA_EDGE_DEPTH : 0;
+		pl->regions[k].depth = first ? ACC_AA_EDGE_DEPTH : 0;
+		pl->regions[k].edges = first && *sparse == SPARSE_EDGES;
 	}
 	return first ? pl->nregions - m : 0;
 }
 
 /*
- * The CPU seconds an antialiased render taken for edges at POV-Ray's depth
- * d costs over region g, by the cost model pp: its corners, ACC_GRID_FRAME^2
- * samples a pixel, and at each pixel whose colour distance (the channels'
- * absolute differences summed, as POV-Ray's threshold measures it) to a
- * neighbour in the row or column reaches ACC_AA_THRESHOLD, EDGE_SAMPLES
- * more at +R4 and half as many a level less.  The edge pass is planned as
+ * The CPU seconds an antialiased render in scale 2's place at POV-Ray's
+ * depth d costs over region g, by the cost model pp: its corners,
+ * ACC_GRID_FRAME^2 samples a pixel, and at each pixel whose colour
+ * distance (the channels' absolute differences summed, as POV-Ray's
+ * threshold measures it) to a neighbour in the row or column reaches
+ * ACC_AA_THRESHOLD, EDGE_SAMPLES more at +R4 and half as many a level
+ * less.  The pass is planned as
  * the scale 2 it replaces, 4 samples a pixel; POV-Ray's subdivisions at
  * twice the size of 160x120 cost, over +R1's corners, per pixel so counted
  * after a base pass: at +R3 13 (Debian's lights/arealit3) to 47 (advanced/
@@ -1568,27 +1573,31 @@ static double edge_render_cost(const struct run *r, const struct plan_params *pp
 }
 
 /*
- * The depth of a pass's antialiased renders taken for edges:
- * ACC_AA_EDGE_DEPTH (+R4), or under a budget +R3 where EDGE_MARGIN times
- * edge_render_cost() at +R4 would not fit it (pp->budget's core-seconds,
- * or for the dearest render the wall time `left`).  At +R4 still_life's
- * edges erred a quarter of +R3's (1.56e-5 to 4.5e-6 at --target 3e-3, 1.3
- * to 1.6 CPU s).  Under --budget 2 a +R4 pass of Debian's
- * advanced/lamppost, planned as scale 2 (0.4 s for 11,416 pixels) and by
+ * The depth of a pass's antialiased renders in scale 2's place, taken for
+ * edges or for a few pixels: ACC_AA_EDGE_DEPTH (+R4), or under a budget
+ * +R3 where EDGE_MARGIN times edge_render_cost() at +R4 would not fit it
+ * (pp->budget's core-seconds, or for the dearest render the wall time
+ * `left`).  At +R4 still_life's edges erred a quarter of +R3's (1.56e-5 to
+ * 4.5e-6 at --target 3e-3, 1.3 to 1.6 CPU s), hdr_highlights' highlights
+ * three quarters (3.1e-4 to 2.3e-4 at 3e-3 and 1e-3, 3.6-4.1 to 4.7-5.2
+ * CPU s), and starfield's stars between corners are no better found
+ * (1.82e-3 to 1.86e-3 at 3e-3, 5.9e-4 to 6.5e-4 at 1e-3).  Under --budget
+ * 2 a +R4 pass of Debian's advanced/lamppost, planned as scale 2 (0.4 s
+ * for 11,416 pixels) and by
  * edge_render_cost() at 1.35 core-s, its dearest render 0.68 s, ran past
  * the deadline 1.56 s on and lost that render: relMSE 9.0e-4 against
  * +R3's 2.8e-5.  The regions keep scale 2's cost for the plan (the pass's
  * cost correction for the next passes is measured against it as before).
  */
 #define EDGE_MARGIN 2.0
-static void edge_depth(const struct run *r, struct plan *pl, const struct plan_params *pp,
-		       double left)
+static void aa_depth(const struct run *r, struct plan *pl, const struct plan_params *pp,
+		     double left)
 {
 	int d = ACC_AA_EDGE_DEPTH;
 	if (r->budget > 0.0) {
 		double sum = 0.0, worst = 0.0;
 		for (size_t k = 0; k < pl->nregions; k++) {
-			if (!pl->regions[k].edges)
+			if (!pl->regions[k].depth)
 				continue;
 			double c = edge_render_cost(r, pp, &pl->regions[k], d);
 			sum += c;
@@ -1598,8 +1607,8 @@ static void edge_depth(const struct run *r, struct plan *pl, const struct plan_p
 			d = 3;
 	}
 	for (size_t k = 0; k < pl->nregions; k++)
-		if (pl->regions[k].edges)
-			pl->regions[k].edges = d;
+		if (pl->regions[k].depth)
+			pl->regions[k].depth = d;
 }
 
 /*
@@ -1739,8 +1748,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			return PASS_STOP;
 		}
 		naa = choose_samplers(r, &pl, &sparse);
-		if (naa && sparse == SPARSE_EDGES)
-			edge_depth(r, &pl, &pp,
+		if (naa)
+			aa_depth(r, &pl, &pp,
 				   r->budget > 0.0 ? r->budget - elapsed(r) - reserve - lat : 0.0);
 		if (!early || prelaunch_cover(r, pass, &pl, &pre_idx))
 			break;
@@ -1835,15 +1844,15 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	double cpu_wall = (pl.cost - (double)n * r->cost_job) / (n < (size_t)r->cores ? (double)n :
 								    r->cores);
 	double guess = rounds * r->latency > cpu_wall ? rounds * r->latency : cpu_wall;
-	int depth = 0;
-	for (size_t k = 0; k < n; k++)
-		depth = pl.regions[k].edges > depth ? pl.regions[k].edges : depth;
-	if (naa && depth)
-		progress(r, "pass %d: the estimated error sits at edges: %zu regions by POV-Ray's "
-			 "antialiasing in place of scale 2, depth %d", pass, naa, depth);
-	else if (naa)
-		progress(r, "pass %d: the estimated error sits in few pixels or at edges: %zu regions by "
-			 "POV-Ray's antialiasing in place of scale 2", pass, naa);
+	int depth = 0, edges = 0;
+	for (size_t k = 0; k < n; k++) {
+		depth = pl.regions[k].depth > depth ? pl.regions[k].depth : depth;
+		edges |= pl.regions[k].edges;
+	}
+	if (naa)
+		progress(r, "pass %d: the estimated error sits %s: %zu regions by POV-Ray's "
+			 "antialiasing in place of scale 2, depth %d", pass,
+			 edges ? "at edges" : "in few pixels", naa, depth ? depth : 3);
 	progress(r, "pass %d: %zu regions, %ld pixels (%ld chosen), %.0f samples, about %.1f s",
 		 pass, n, pl.pixels, pl.chosen_pixels, pl.samples, guess + r->latency);
 	int rc = pov_pool_run(jobs, n, &po, results, err, errlen);
@@ -1874,7 +1883,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			continue;
 		}
 		long folded = 0;
-		if (g->edges ? accum_merge_edge_file(&r->acc, outs[k], s, g->edges, g->x0, g->y0,
+		if (g->edges ? accum_merge_edge_file(&r->acc, outs[k], s, g->depth, g->x0, g->y0,
 						     g->x1, g->y1, pass, &folded, err, errlen)
 			     : accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1, pass,
 						&folded, err, errlen)) {

@@ -1762,9 +1762,9 @@ static void test_edge_error(void **state)
 static void test_regions_file(void **state)
 {
 	struct plan_region rs[3] = {
-		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1, 0, 0 },
-		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2, 0, 0 },
-		{ 63, 47, 63, 47, 16, 1, 0.1, 0.3, 0, 0 },
+		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1, 0, 0, 0 },
+		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2, 0, 0, 0 },
+		{ 63, 47, 63, 47, 16, 1, 0.1, 0.3, 0, 0, 0 },
 	};
 	static char o0[] = "r0.exr", o1[] = "a dir/with spaces/region 1.exr",
 		o2[] = "/tmp/x y  z.exr";
@@ -1852,7 +1852,7 @@ static void test_plan_job(void **state)
 {
 	static const char *const base_extra[] = { "+Q9", "Antialias_Threshold=0.1" };
 	struct pov_job base, job;
-	struct plan_region r = { 3, 2, 10, 7, 4, 0, 0.0, 0.0, 0, 0 };
+	struct plan_region r = { 3, 2, 10, 7, 4, 0, 0.0, 0.0, 0, 0, 0 };
 	struct pov_region region;
 	const char *extra[3];
 
@@ -1892,16 +1892,16 @@ static void test_plan_job(void **state)
 	plan_job(&base, &r, "out/a1.exr", &region, aextra, &job);
 	assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
 	assert_aa_options(&job, "+AM2", "+A0.1", "+R3", "+J");
-	/* taken for edges: the depth it was given */
+	/* at the depth it was given (render.c, aa_depth()) */
 	for (int d = 1; d <= ACC_AA_EDGE_DEPTH; d++) {
 		char want[8];
 		snprintf(want, sizeof(want), "+R%d", d);
-		r.edges = d;
+		r.depth = d;
 		plan_job(&base, &r, "out/a2.exr", &region, aextra, &job);
 		assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
 		assert_aa_options(&job, "+AM2", "+A0.1", want, "+J");
 	}
-	r.edges = 0;
+	r.depth = 0;
 	r.frame = 0;
 	char name[64];
 	plan_output_name(name, sizeof(name), "w", 3, 7, ACC_AA);
