@@ -286,11 +286,9 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			const int half = f == ACC_GRID_FRAME;	/* in scale 2's place */
 			const int first = half && !(o[ACC_SAMPLES] >= 2.0f);
 			const int edge = half && edges;
-			const double ek = edge ? edge_cells(range, cells) : 0.0;
+			const double ek = first && edge ? edge_cells(range, cells) : 1.0;
 			int k = first ? (ek > ACC_AA_FIRST ? (int)lround(ek) : ACC_AA_FIRST)
 				      : own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
-			for (int c = 0; c < 3; c++)
-				m2[c] = k > 1 ? (double)o[ACC_VAR_R + c] * (k - 1) : 0.0;
 			/* taken for edges, the cells vary as the render pixels
 			 * do (v is their mean's variance): a shading ramp
 			 * across the pixel shows in its variance as a ramp
@@ -300,9 +298,10 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			 * edges hidden between the render's corners: 5.4e-5 of
 			 * its estimate of 6.9e-5 after the pass, for a true
 			 * relMSE of 1.6e-6 over those pixels; so 1.6e-5) */
-			if (first && edge)
-				for (int c = 0; c < 3; c++)
-					m2[c] = 4.0 * v[c] * (k - 1);
+			for (int c = 0; c < 3; c++)
+				m2[c] = k < 2 ? 0.0
+					: first && edge ? 4.0 * v[c] * (k - 1)
+							: (double)o[ACC_VAR_R + c] * (k - 1);
 			double na = o[ACC_SAMPLES], prev = o[ACC_DIFF];
 			if (accum_fold(acc, i, ACC_AA, k, mean, m2, pass))
 				continue;
@@ -354,7 +353,7 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			 * Taken for edges, the spread is over the cells the render
 			 * pixels stand for (edge_cells()). */
 			if (first) {
-				double rv = rel3(o, v) / (edge ? edge_cells(range, cells) : 1.0);
+				double rv = rel3(o, v) / ek;
 				if (isfinite(rv) && rv < diff)
 					diff = rv;
 			}
@@ -699,15 +698,22 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, 0, folded, err, errlen);
 }
 
+/* Whether depth is not one an antialiased render taken for edges may have
+ * (the message in err). */
+static int bad_depth(int depth, char *err, size_t errlen)
+{
+	if (depth >= 1 && depth <= ACC_AA_DEPTH)
+		return 0;
+	errbuf_printf(err, errlen, "antialiasing depth %d is not 1 to %d", depth, ACC_AA_DEPTH);
+	return 1;
+}
+
 int accum_merge_edge_region(struct image *acc, const struct image *img, int oy, int s,
 			    int depth, int x0, int y0, int x1, int y1, int pass, long *folded,
 			    char *err, size_t errlen)
 {
-	if (depth < 1 || depth > ACC_AA_EDGE_DEPTH) {
-		errbuf_printf(err, errlen, "antialiasing depth %d is not 1 to %d", depth,
-			      ACC_AA_EDGE_DEPTH);
+	if (bad_depth(depth, err, errlen))
 		return -1;
-	}
 	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, depth, folded, err, errlen);
 }
 
@@ -740,11 +746,8 @@ int accum_merge_edge_file(struct image *acc, const char *path, int s, int depth,
 			  int y0, int x1, int y1, int pass, long *folded, char *err,
 			  size_t errlen)
 {
-	if (depth < 1 || depth > ACC_AA_EDGE_DEPTH) {
-		errbuf_printf(err, errlen, "antialiasing depth %d is not 1 to %d", depth,
-			      ACC_AA_EDGE_DEPTH);
+	if (bad_depth(depth, err, errlen))
 		return -1;
-	}
 	return merge_file(acc, path, s, x0, y0, x1, y1, pass, depth, folded, err, errlen);
 }
 

@@ -84,7 +84,7 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * subdivided (its f x f render pixels differ by POV-Ray's threshold,
  * ACC_AA_THRESHOLD, or more).  At an edge the render's corners are half
  * a pixel apart and where they differ by the threshold POV-Ray
- * subdivides, to 1/16 of a pixel at +R4 (ACC_AA_EDGE_DEPTH; +R3 where a
+ * subdivides, to 1/16 of a pixel at +R4 (ACC_AA_DEPTH; +R3 where a
  * budget leaves too little time, render.c's aa_depth()) in the
  * twice-size frame: the pixel is accum_edge_cells(depth) cells' mean (at
  * +R4 2 x 2 render pixels of 8 x 8), and the base pass's one sample at its
@@ -115,7 +115,7 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
 /* POV-Ray's depth for an antialiased render in scale 2's place, for edges
  * or a few pixels alike (render.c's aa_depth(): +R3 under a budget that
  * would not fit it) */
-#define ACC_AA_EDGE_DEPTH 4
+#define ACC_AA_DEPTH 4
 
 /* The cells a pixel of such a render at POV-Ray's depth d stands for:
  * 2 x 2 render pixels of 2^(d-1) x 2^(d-1) (64 at +R3, 256 at +R4). */
@@ -123,7 +123,6 @@ static inline int accum_edge_cells(int d)
 {
 	return 1 << (2 * d);
 }
-#define ACC_AA_EDGE_CELLS (1 << (2 * ACC_AA_EDGE_DEPTH))
 #define ACC_AA_THRESHOLD 0.1
 
 /* A region render of scale s is accum_render_factor(s) times the image's
@@ -223,7 +222,7 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
 
 /* accum_merge_region() and accum_merge_file() of an antialiased render in
  * scale 2's place (s ACC_AA, twice the image's size) taken for edges, at
- * POV-Ray's depth `depth` (+R, 1 to ACC_AA_EDGE_DEPTH): folded as
+ * POV-Ray's depth `depth` (+R, 1 to ACC_AA_DEPTH): folded as
  * ACC_AA_EDGE says, over accum_edge_cells(depth) cells.  Any other render
  * is folded as by the two. */
 int accum_merge_edge_region(struct image *acc, const struct image *img, int oy, int s,

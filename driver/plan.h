@@ -100,10 +100,10 @@ struct plan_region {
 				 * accum_render_factor(scale), or
 				 * ACC_GRID_FRAME for a grid render or, with
 				 * scale ACC_AA, an antialiased render in scale
-				 * 2's place (+A0.1 +R3 rather than +A0.0 +R4;
-				 * render.c, choose_samplers()) */
+				 * 2's place (+A0.1 +R(depth) rather than +A0.0
+				 * +R4; render.c, choose_samplers()) */
 	int depth;		/* such a render's POV-Ray depth (+R, 1 to
-				 * ACC_AA_EDGE_DEPTH; 0 for +R3) */
+				 * ACC_AA_DEPTH; 0 for +R3) */
 	int edges;		/* such a render taken for edges (render.c's
 				 * edge rule), folded so
 				 * (accum_merge_edge_file()) */

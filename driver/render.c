@@ -1239,7 +1239,7 @@ static void prelaunch_first(struct run *r)
 	if (r->grid != PLAN_GRID_NEVER && !r->focal)	/* one_step()'s jitter */
 		kinds[nk++] = (struct pre_kind){ 4, ACC_GRID_FRAME, 0, 0 };
 	if (r->grid == PLAN_GRID_LARGE && !r->aa)
-		kinds[nk++] = (struct pre_kind){ ACC_AA, ACC_GRID_FRAME, ACC_AA_EDGE_DEPTH, 0 };
+		kinds[nk++] = (struct pre_kind){ ACC_AA, ACC_GRID_FRAME, ACC_AA_DEPTH, 0 };
 	prelaunch_start(r, 1, kinds, nk, r->cores);
 }
 
@@ -1257,7 +1257,8 @@ static void prelaunch_next(struct run *r, int pass, const struct plan *pl,
 		return;
 	struct plan_params next = *pp;
 	next.grid = run_grid(r);
-	struct pre_kind kind = { s, plan_grid_scale(&next, r->w, r->h, s) ? ACC_GRID_FRAME : 0, 0, 0 };
+	const int frame = plan_grid_scale(&next, r->w, r->h, s) ? ACC_GRID_FRAME : 0;
+	struct pre_kind kind = { s, frame, 0, 0 };
 	if (!kind.frame && (double)s * s * r->w * r->h > PLAN_MAX_FRAME)
 		return;	/* a frame no region render gets */
 	prelaunch_start(r, pass, &kind, 1, 2 * r->cores);
@@ -1526,7 +1527,7 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
 	for (size_t k = m; k < pl->nregions; k++) {
 		pl->regions[k].scale = ACC_AA;
 		pl->regions[k].frame = first ? ACC_GRID_FRAME : 0;
-		pl->regions[k].depth = first ? ACC_AA_EDGE_DEPTH : 0;
+		pl->regions[k].depth = first ? ACC_AA_DEPTH : 0;
 		pl->regions[k].edges = first && *sparse == SPARSE_EDGES;
 	}
 	return first ? pl->nregions - m : 0;
@@ -1539,12 +1540,14 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
  * distance (the channels' absolute differences summed, as POV-Ray's
  * threshold measures it) to a neighbour in the row or column reaches
  * ACC_AA_THRESHOLD, EDGE_SAMPLES more at +R4 and half as many a level
- * less.  The pass is planned as
- * the scale 2 it replaces, 4 samples a pixel; POV-Ray's subdivisions at
- * twice the size of 160x120 cost, over +R1's corners, per pixel so counted
- * after a base pass: at +R3 13 (Debian's lights/arealit3) to 47 (advanced/
- * lamppost) base-pass samples' time, at +R4 20 to 106 (still_life 30 and
- * 59, lights/soft 43 and 73; one run each, 2026-12-02).
+ * less.  The pass is planned as the scale 2 it replaces, 4 samples a
+ * pixel.  POV-Ray's subdivisions at twice the size of 160x120 (+AM2 +A0.1
+ * +J, one thread) cost, over +R1's corners, per pixel so counted in a
+ * render without antialiasing, in that render's CPU per pixel: at +R3 12
+ * (Debian's lights/arealit3) to 66 (lights/shadows), at +R4 20 (arealit3)
+ * to 120 (lights/arealit1); still_life 30 and 59, advanced/lamppost 47 and
+ * 105, lights/soft 43 and 73 (one run each, 2026-12-02).  The margin in
+ * aa_depth() covers the dearest.
  */
 #define EDGE_SAMPLES 100.0
 static double edge_render_cost(const struct run *r, const struct plan_params *pp,
@@ -1574,7 +1577,7 @@ static double edge_render_cost(const struct run *r, const struct plan_params *pp
 
 /*
  * The depth of a pass's antialiased renders in scale 2's place, taken for
- * edges or for a few pixels: ACC_AA_EDGE_DEPTH (+R4), or under a budget
+ * edges or for a few pixels: ACC_AA_DEPTH (+R4), or under a budget
  * +R3 where EDGE_MARGIN times edge_render_cost() at +R4 would not fit it
  * (pp->budget's core-seconds, or for the dearest render the wall time
  * `left`).  At +R4 still_life's edges erred a quarter of +R3's (1.56e-5 to
@@ -1593,7 +1596,7 @@ static double edge_render_cost(const struct run *r, const struct plan_params *pp
 static void aa_depth(const struct run *r, struct plan *pl, const struct plan_params *pp,
 		     double left)
 {
-	int d = ACC_AA_EDGE_DEPTH;
+	int d = ACC_AA_DEPTH;
 	if (r->budget > 0.0) {
 		double sum = 0.0, worst = 0.0;
 		for (size_t k = 0; k < pl->nregions; k++) {
@@ -1885,8 +1888,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		long folded = 0;
 		if (g->edges ? accum_merge_edge_file(&r->acc, outs[k], s, g->depth, g->x0, g->y0,
 						     g->x1, g->y1, pass, &folded, err, errlen)
-			     : accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1, pass,
-						&folded, err, errlen)) {
+			     : accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1,
+						pass, &folded, err, errlen)) {
 			fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n", pass,
 				g->x0, g->y0, g->x1, g->y1, err);
 			p.failed++;

@@ -382,9 +382,10 @@ if ref=$(S=9 W=160 H=120 reference "$scene"); then
 	check "... and says why, at depth 4" grep -q "error sits at edges: .* depth 4" "$T/sl-auto.log"
 	auto_beats_scale sl "$scene" "$ref" 0.25 "still_life: relMSE at most a quarter of scale 2's"
 	# under a budget that +R4 would not fit twice over, depth 3 (its edge
-	# pass by the cost model about 2.2 core-s, against about 1.1 core-s
-	# for the pass at 1.2 s; at 2 s, 2.5, the measured cost of a sample
-	# decides, and one run of three took depth 4)
+	# pass by the cost model about 2.2 core-s, printed by a scratch build
+	# at 2 s, against the pass's share of 1.2 s, about 1.1 core-s by
+	# render.c's formula; at 2 s that share, 2.5 core-s, is close enough
+	# that the measured cost of a sample decides: one run of three took 4)
 	"$PP" render "$scene" -o "$T/sl-b2.exr" -W 160 -H 120 --budget 1.2 --target 1e-6 -v \
 		-- +WT1 2>"$T/sl-b2.log" || bad "still_life --budget 1.2: render failed"
 	check "still_life --budget 1.2: the edge pass at depth 3" \

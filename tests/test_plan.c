@@ -784,7 +784,7 @@ static double edge_cells_want(double range, double cells)
 }
 
 /* 3c. An antialiased render in scale 2's place taken for edges at depth
- * d (4, ACC_AA_EDGE_DEPTH, and 3): over a pixel's one sample it counts as
+ * d (4, ACC_AA_DEPTH, and 3): over a pixel's one sample it counts as
  * the cells POV-Ray subdivided it into (4^d where its render pixels' colour
  * distance reaches the threshold, at least ACC_AA_FIRST), whose variance
  * is its 2 x 2 render pixels', its fold is
@@ -811,69 +811,69 @@ static void test_merge_aa_edges(void **state)
 			for (int c = 0; c < 3; c++)
 				big.px[((size_t)Y * 10 + X) * 3 + c] =
 					(float)(0.4 + 0.1 * c + spread[X / 2] * pat[Y * 2 + X % 2]);
-	assert_int_equal(ACC_AA_EDGE_CELLS, accum_edge_cells(ACC_AA_EDGE_DEPTH));
+	assert_int_equal(accum_edge_cells(ACC_AA_DEPTH), 256);
 	assert_int_equal(accum_edge_cells(3), 64);
 	make_acc(&plain, 5, 1, flat_value);
 	assert_int_equal(accum_merge_region(&plain, &big, 0, ACC_AA, 0, 0, 4, 0, 1, &folded, err,
 					    sizeof(err)), 0);
 	for (int depth = 3; depth <= 4; depth++) {
-	make_acc(&acc, 5, 1, flat_value);
-	assert_int_equal(accum_merge_edge_region(&acc, &big, 0, ACC_AA, depth, 0, 0, 4, 0, 1,
-						 &folded, err, sizeof(err)), 0);
-	assert_int_equal(folded, 5);
-	const int cells = accum_edge_cells(depth);
-	for (int x = 0; x < 5; x++) {
-		const float *o = accpx(&acc, (size_t)x), *q = accpx(&plain, (size_t)x);
-		const double range = 3.0 * spread[x];
-		/* the samples it stands for: the cells it was subdivided
-		 * into, at least ACC_AA_FIRST */
-		const double ek = edge_cells_want(range, cells);
-		const int k = ek > ACC_AA_FIRST ? (int)lround(ek) : ACC_AA_FIRST;
-		assert_true(o[ACC_SAMPLES] == (float)(1 + k));
-		if (range >= ACC_AA_THRESHOLD)
-			assert_int_equal(k, cells);
-		assert_true(q[ACC_SAMPLES] == (float)(1 + ACC_AA_FIRST));
-		double d = 0.0, v = 0.0;
-		for (int c = 0; c < 3; c++) {
-			const double m = 0.4 + 0.1 * c;	/* the 2 x 2 mean */
-			assert_close(o[c], (0.5 + k * m) / (1 + k), 1e-6, 0.0,
-				     "the base sample and the mean, 1 to the cells");
-			const double den = (double)o[c] * o[c] + METRICS_RELMSE_EPS;
-			d += (m - 0.5) * (m - 0.5) / den / 3.0;
-			/* four values +-spread/2: variance spread^2/3, over 4 */
-			v += spread[x] * spread[x] / 3.0 / 4.0 / den / 3.0;
-			/* the cells vary as the render pixels, spread^2/3, and
-			 * the base sample 0.5 adds its difference */
-			const double m2 = spread[x] * spread[x] / 3.0 * (k - 1) +
-					  (m - 0.5) * (m - 0.5) * k / (1.0 + k);
-			assert_close(o[ACC_VAR_R + c], m2 / k, 1e-4, 1e-9,
-				     "the cells' variance: the render pixels'");
+		make_acc(&acc, 5, 1, flat_value);
+		assert_int_equal(accum_merge_edge_region(&acc, &big, 0, ACC_AA, depth, 0, 0, 4, 0,
+							 1, &folded, err, sizeof(err)), 0);
+		assert_int_equal(folded, 5);
+		const int cells = accum_edge_cells(depth);
+		for (int x = 0; x < 5; x++) {
+			const float *o = accpx(&acc, (size_t)x), *q = accpx(&plain, (size_t)x);
+			const double range = 3.0 * spread[x];
+			/* the samples it stands for: the cells it was subdivided
+			 * into, at least ACC_AA_FIRST */
+			const double ek = edge_cells_want(range, cells);
+			const int k = ek > ACC_AA_FIRST ? (int)lround(ek) : ACC_AA_FIRST;
+			assert_true(o[ACC_SAMPLES] == (float)(1 + k));
+			if (range >= ACC_AA_THRESHOLD)
+				assert_int_equal(k, cells);
+			assert_true(q[ACC_SAMPLES] == (float)(1 + ACC_AA_FIRST));
+			double d = 0.0, v = 0.0;
+			for (int c = 0; c < 3; c++) {
+				const double m = 0.4 + 0.1 * c;	/* the 2 x 2 mean */
+				assert_close(o[c], (0.5 + k * m) / (1 + k), 1e-6, 0.0,
+					     "the base sample and the mean, 1 to the cells");
+				const double den = (double)o[c] * o[c] + METRICS_RELMSE_EPS;
+				d += (m - 0.5) * (m - 0.5) / den / 3.0;
+				/* four values +-spread/2: variance spread^2/3, over 4 */
+				v += spread[x] * spread[x] / 3.0 / 4.0 / den / 3.0;
+				/* the cells vary as the render pixels, spread^2/3, and
+				 * the base sample 0.5 adds its difference */
+				const double m2 = spread[x] * spread[x] / 3.0 * (k - 1) +
+						  (m - 0.5) * (m - 0.5) * k / (1.0 + k);
+				assert_close(o[ACC_VAR_R + c], m2 / k, 1e-4, 1e-9,
+					     "the cells' variance: the render pixels'");
+			}
+			const double w = k, full = (w * w + 1.0) / ((1.0 + w) * (1.0 + w)) * d;
+			const double bound = v / edge_cells_want(range, cells);
+			assert_close(o[ACC_DIFF], full < bound ? full : bound, 1e-4, 1e-12,
+				     "the edge fold's error: the spread over its cells");
+			if (x >= 3)	/* the bound acts where the pixel differs */
+				assert_true(o[ACC_DIFF] < full);
+			if (x == 2)	/* between a tenth of the threshold and it */
+				assert_true(edge_cells_want(range, cells) > 1.0 &&
+					    edge_cells_want(range, cells) < cells);
+			assert_true(accum_has_scale(&acc, (size_t)x, ACC_AA_HALF));
+			assert_true(accum_has_scale(&acc, (size_t)x, ACC_AA_NOGRID));
+			assert_true(accum_has_scale(&acc, (size_t)x, ACC_AA_EDGE));
+			assert_int_equal(accum_has_scale(&acc, (size_t)x, ACC_AA_DEEP),
+					 range >= ACC_AA_THRESHOLD);
+			assert_false(accum_has_scale(&plain, (size_t)x, ACC_AA_EDGE));
+			assert_false(accum_has_scale(&plain, (size_t)x, ACC_AA_DEEP));
+			assert_true(accum_has_scale(&plain, (size_t)x, ACC_AA_NOGRID));
 		}
-		const double w = k, full = (w * w + 1.0) / ((1.0 + w) * (1.0 + w)) * d;
-		const double bound = v / edge_cells_want(range, cells);
-		assert_close(o[ACC_DIFF], full < bound ? full : bound, 1e-4, 1e-12,
-			     "the edge fold's error: the spread over its cells");
-		if (x >= 3)	/* the bound acts where the pixel differs */
-			assert_true(o[ACC_DIFF] < full);
-		if (x == 2)	/* between a tenth of the threshold and it */
-			assert_true(edge_cells_want(range, cells) > 1.0 &&
-				    edge_cells_want(range, cells) < cells);
-		assert_true(accum_has_scale(&acc, (size_t)x, ACC_AA_HALF));
-		assert_true(accum_has_scale(&acc, (size_t)x, ACC_AA_NOGRID));
-		assert_true(accum_has_scale(&acc, (size_t)x, ACC_AA_EDGE));
-		assert_int_equal(accum_has_scale(&acc, (size_t)x, ACC_AA_DEEP),
-				 range >= ACC_AA_THRESHOLD);
-		assert_false(accum_has_scale(&plain, (size_t)x, ACC_AA_EDGE));
-		assert_false(accum_has_scale(&plain, (size_t)x, ACC_AA_DEEP));
-		assert_true(accum_has_scale(&plain, (size_t)x, ACC_AA_NOGRID));
-	}
-	if (depth < ACC_AA_EDGE_DEPTH)
-		image_release(&acc);	/* the deepest goes on below */
+		if (depth < ACC_AA_DEPTH)
+			image_release(&acc);	/* the deepest goes on below */
 	}
 	for (int depth = 0; depth <= 5; depth += 5) {
 		err[0] = '\0';
-		assert_int_equal(accum_merge_edge_region(&acc, &big, 0, ACC_AA, depth, 0, 0, 4, 0, 2,
-							 &folded, err, sizeof(err)), -1);
+		assert_int_equal(accum_merge_edge_region(&acc, &big, 0, ACC_AA, depth, 0, 0, 4, 0,
+							 2, &folded, err, sizeof(err)), -1);
 		assert_non_null(strstr(err, "depth"));
 	}
 	image_release(&plain);
@@ -1893,7 +1893,7 @@ static void test_plan_job(void **state)
 	assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
 	assert_aa_options(&job, "+AM2", "+A0.1", "+R3", "+J");
 	/* at the depth it was given (render.c, aa_depth()) */
-	for (int d = 1; d <= ACC_AA_EDGE_DEPTH; d++) {
+	for (int d = 1; d <= ACC_AA_DEPTH; d++) {
 		char want[8];
 		snprintf(want, sizeof(want), "+R%d", d);
 		r.depth = d;
