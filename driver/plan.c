@@ -181,8 +181,6 @@ static int grid_at(const struct plan_params *p, int s, double px)
 			  (p->grid == PLAN_GRID_LARGE && (double)s * s * px > p->grid_frame));
 }
 
-/* A render's fixed cost at scale s in an image of px pixels: the
- * invocation and, with cost_frame, its frame. */
 static double job_cost(const struct plan_params *p, int s, double px)
 {
 	if (!(p->cost_frame > 0.0))
@@ -190,10 +188,33 @@ static double job_cost(const struct plan_params *p, int s, double px)
 	return p->cost_job + p->cost_frame * px * (grid_at(p, s, px) ? 4.0 : (double)s * s);
 }
 
+double plan_job_cost(const struct plan_params *p, int s, double px)
+{
+	return job_cost(p, s, px);
+}
+
+/* The cost map's sum over pixels x0..x1 x y0..y1 (inclusive): their area
+ * without a map. */
+static double map_sum(const struct plan_params *p, int x0, int y0, int x1, int y1)
+{
+	if (!p->cost_sat)
+		return (double)(x1 - x0 + 1) * (y1 - y0 + 1);
+	const size_t sw = (size_t)p->cost_sat_w + 1;
+	const double *t = p->cost_sat;
+	return t[(size_t)(y1 + 1) * sw + x1 + 1] - t[(size_t)y0 * sw + x1 + 1] -
+	       t[(size_t)(y1 + 1) * sw + x0] + t[(size_t)y0 * sw + x0];
+}
+
+/* Pixel i's cost a sample over cost_sample. */
+static double map_at(const struct plan_params *p, size_t i)
+{
+	return p->cost_map ? p->cost_map[i] : 1.0;
+}
+
 static double rect_cost(const struct plan_params *p, const struct plan_region *r, double px)
 {
 	return job_cost(p, r->scale, px) +
-	       p->cost_sample * (double)plan_region_area(r) * r->scale * r->scale;
+	       p->cost_sample * map_sum(p, r->x0, r->y0, r->x1, r->y1) * r->scale * r->scale;
 }
 
 static void bbox(const struct plan_region *a, const struct plan_region *b,
@@ -459,7 +480,7 @@ static int next_upgrade(const struct plan_params *p, const struct image *acc, si
 	u->i = i;
 	u->to = to;
 	u->gain = e * (m2 / (n + m2) - m1 / (n + m1));
-	u->cost = p->cost_sample * (m2 - m1);
+	u->cost = p->cost_sample * (m2 - m1) * map_at(p, i);
 	u->score = u->gain / u->cost;
 	return 1;
 }
@@ -489,8 +510,28 @@ static void region_count(const struct plan_params *p, struct plan_region *r,
 	r->cost = rect_cost(p, r, plan_px(out));
 }
 
+/* The last row (rows) or column of region r's first part when it is cut
+ * where the cost map's sum over it halves, both parts one or more wide. */
+static int cost_half(const struct plan_params *p, const struct plan_region *r, int rows)
+{
+	const int lo = rows ? r->y0 : r->x0, hi = rows ? r->y1 : r->x1;
+	const double half = 0.5 * map_sum(p, r->x0, r->y0, r->x1, r->y1);
+	int a = lo, b = hi - 1;	/* the answer lies in a..b */
+	while (a < b) {
+		int m = a + (b - a) / 2;
+		double c = rows ? map_sum(p, r->x0, r->y0, r->x1, m) :
+				  map_sum(p, r->x0, r->y0, m, r->y1);
+		if (c < half)
+			a = m + 1;
+		else
+			b = m;
+	}
+	return a;
+}
+
 /*
- * Split the dearest region in two across its longer side while it costs
+ * Split the dearest region in two (across its longer side, or with a cost
+ * map as plan_params says) while it costs
  * more than the pass over p->min_split, renders more than four
  * invocations' worth of samples, and the plan has fewer than twice
  * p->max_regions: so that the cores finish together.  (With the cap at
@@ -519,9 +560,13 @@ static int split_regions(const struct plan_params *p, struct plan *out, const un
 			break;
 		if (rh >= rw) {
 			a.y1 = a.y0 + rh / 2 - 1;
+			if (p->cost_map)
+				a.y1 = cost_half(p, &a, 1);
 			b.y0 = a.y1 + 1;
 		} else {
 			a.x1 = a.x0 + rw / 2 - 1;
+			if (p->cost_map)
+				a.x1 = cost_half(p, &a, 0);
 			b.x0 = a.x1 + 1;
 		}
 		region_count(p, &a, out, ps, gain);
@@ -695,7 +740,25 @@ int plan_make(const struct image *acc, const float *press, const float *fit,
 	return rc;
 }
 
-int plan_make_from(const struct image *acc, const double *e, const struct plan_params *p,
+/* The summed-area table of a w x h cost map, (w + 1) x (h + 1); NULL when
+ * out of memory. */
+static double *map_table(const float *map, int w, int h)
+{
+	const size_t sw = (size_t)w + 1;
+	double *t = calloc(sw * ((size_t)h + 1), sizeof(*t));
+	if (!t)
+		return NULL;
+	for (int y = 0; y < h; y++) {
+		double row = 0.0;
+		for (int x = 0; x < w; x++) {
+			row += map[(size_t)y * w + x];
+			t[(size_t)(y + 1) * sw + x + 1] = t[(size_t)y * sw + x + 1] + row;
+		}
+	}
+	return t;
+}
+
+int plan_make_from(const struct image *acc, const double *e, const struct plan_params *pin,
 		   struct plan *out, char *err, size_t errlen)
 {
 	const int w = acc->w, h = acc->h;
@@ -704,6 +767,19 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	struct cand *cand = NULL;
 	unsigned char *mark = NULL, *ps = NULL;
 	struct upgrade *heap = NULL;
+	struct plan_params pm = *pin;
+	const struct plan_params *p = &pm;
+	double *sat = NULL;
+	pm.cost_sat = NULL;
+	pm.cost_sat_w = w;
+	if (pm.cost_map) {
+		if (!(sat = map_table(pm.cost_map, w, h))) {
+			memset(out, 0, sizeof(*out));
+			errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
+			return -1;
+		}
+		pm.cost_sat = sat;
+	}
 	int ret = -1;
 
 	memset(out, 0, sizeof(*out));
@@ -753,7 +829,7 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 		cand[nc].i = i;
 		cand[nc].s = s;
 		cand[nc].gain = g;
-		cand[nc].score = g / m;
+		cand[nc].score = g / (m * map_at(p, i));
 		nc++;
 	}
 	qsort(cand, nc, sizeof(*cand), by_score);
@@ -766,7 +842,7 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	size_t taken = 0;
 	for (; taken < nc && total0 > goal; taken++) {
 		const struct cand *c = &cand[taken];
-		double cs = p->cost_sample * c->s * c->s;
+		double cs = p->cost_sample * c->s * c->s * map_at(p, c->i);
 		if (spend0 + cs > cap)
 			break;
 		spend0 += cs;
@@ -915,6 +991,7 @@ out:
 	free(mark);
 	free(ps);
 	free(heap);
+	free(sat);
 	if (ret)
 		plan_release(out);
 	return ret;

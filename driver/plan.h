@@ -60,7 +60,24 @@ struct plan_params {
 				 * 2 max_regions, until none costs more than the
 				 * pass over min_split (the cores that render
 				 * it at once; default 0: no splitting) */
+	const float *cost_map;	/* w*h or NULL: each pixel's cost a sample
+				 * over cost_sample (render.c measures it from
+				 * its region renders under a budget).  With a
+				 * map, candidates, upgrades and rectangles are
+				 * costed by it, and a region is split across
+				 * its rows where its cost halves (across its
+				 * columns when more than twice as wide as
+				 * tall); NULL (default): 1 everywhere, split
+				 * across the longer side at its middle */
+	/* set by the planner from cost_map: its summed-area table,
+	 * (w + 1) x (h + 1), and w */
+	const double *cost_sat;
+	int cost_sat_w;
 };
+
+/* A render's fixed cost, seconds, at scale s in an image of px pixels: one
+ * invocation and, with cost_frame, its frame. */
+double plan_job_cost(const struct plan_params *p, int s, double px);
 
 /* Grid renders: never (resolution scaling), for every scale of 4 or more,
  * or for those whose scaled frame would exceed grid_frame pixels

@@ -250,8 +250,11 @@ struct run {
 	int pre_pass;		/* the pass they are for */
 	unsigned pre_rad;	/* or, bit k set: the radiosity pass at scale k
 				 * (prelaunch_radiosity()) */
-	double cost_corr;	/* under a budget, the last pass's CPU over its
-				 * predicted cost (cost_scale()) */
+	float *cost_map;	/* under a budget, w*h: each pixel's cost a
+				 * sample over cost_sample, as its region
+				 * renders measured it (learn_costs()); else
+				 * NULL */
+	int cost_learnt;	/* region renders the map has learnt from */
 	double pre_latency;	/* an early render's wait from its gate to its
 				 * image, less its CPU (measured; PRE_LATENCY
 				 * until then) */
@@ -670,19 +673,16 @@ static int run_grid(const struct run *r)
 	return r->jittered && r->grid == PLAN_GRID_LARGE ? PLAN_GRID_ONLY : r->grid;
 }
 
-/*
- * What the planner's costs are multiplied by: under a budget, the last
- * pass's CPU over what its plan predicted for the regions it rendered
- * (within 0.5 to 4), since the regions a pass picks are not the frame the
- * base pass measured (glossy_reflection's reflecting floor costs more a
- * sample): at --budget 8 its last pass was planned 1.3 to 1.4 times too
- * cheap and lost two region renders to the deadline in each of three runs
- * (2026-11-23 02:11 UTC sweep); 1 without a budget, whose plans must not
- * follow timing noise.
- */
-static double cost_scale(const struct run *r)
+/* The cost map's mean, for the report: 1 without a budget. */
+static double cost_map_mean(const struct run *r)
 {
-	return r->budget > 0.0 ? r->cost_corr : 1.0;
+	if (!r->cost_map)
+		return 1.0;
+	const size_t npx = (size_t)r->w * r->h;
+	double sum = 0.0;
+	for (size_t i = 0; i < npx; i++)
+		sum += r->cost_map[i];
+	return npx ? sum / (double)npx : 1.0;
 }
 
 static int write_report(struct run *r, double est, char *err, size_t errlen)
@@ -705,7 +705,7 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 		"  \"radiosity_scale\": %d,\n  \"focal_blur\": %s,\n  \"povwait\": %s,\n"
 		"  \"sampler\": \"%s\",\n  \"sampler_chosen\": \"%s\",\n  \"prelaunch\": \"%s\",\n"
 		"  \"final\": \"%s\",\n  \"passes\": [\n",
-		r->cost_job, r->cost_sample, r->latency, cost_scale(r), r->radiosity ? "true" : "false",
+		r->cost_job, r->cost_sample, r->latency, cost_map_mean(r), r->radiosity ? "true" : "false",
 		r->rad_scale, r->focal ? "true" : "false", pov_wait_library() ? "true" : "false",
 		r->aa ? "aa" : plan_grid_name(r->grid),
 		r->aa ? "aa" : plan_grid_name(run_grid(r)),
@@ -1291,7 +1291,7 @@ static size_t prelaunch_cover(struct run *r, int pass, struct plan *pl, size_t *
 	double cost;
 	int nk;
 	const struct pre_kind K = main_kind(pl, &area, &cost, &nk);
-	const double job = r->cost_job * cost_scale(r);	/* as the plan costs it */
+	const double job = r->cost_job;	/* as the plan costs it */
 	double per_px = (cost - nk * job) / (double)area;
 	if (per_px < 0.0)
 		per_px = 0.0;
@@ -1571,8 +1571,18 @@ static double edge_render_cost(const struct run *r, const struct plan_params *pp
 			e += edge;
 		}
 	const double f2 = (double)ACC_GRID_FRAME * ACC_GRID_FRAME;
-	return pp->cost_job + pp->cost_sample * (f2 * (double)plan_region_area(g) +
-						 ldexp(EDGE_SAMPLES, d - 4) * (double)e);
+	double m = 0.0;	/* the region's cost a sample, the cost map's mean */
+	if (pp->cost_map) {
+		for (int y = g->y0; y <= g->y1; y++)
+			for (int x = g->x0; x <= g->x1; x++)
+				m += pp->cost_map[(size_t)y * acc->w + x];
+		m /= (double)plan_region_area(g);
+	} else {
+		m = 1.0;
+	}
+	return pp->cost_job + pp->cost_sample * m *
+				      (f2 * (double)plan_region_area(g) +
+				       ldexp(EDGE_SAMPLES, d - 4) * (double)e);
 }
 
 /*
@@ -1673,6 +1683,67 @@ static double final_reserve(const struct run *r)
 }
 
 /*
+ * Under a budget, the cost map from what a pass's region renders took: a
+ * region's CPU less its invocation's, over the cost the plan gave its
+ * samples, scales its pixels' costs (within 1/LEARN_MAX and LEARN_MAX a
+ * pass, the map within COST_MIN and COST_MAX), so that the next plans
+ * cost each pixel as its own renders did, not at the base pass's average.
+ * A render stopped at the deadline took at least its CPU: its pixels' costs
+ * grow when that is more than planned.  Not learnt from: antialiased
+ * renders (planned at scale 2's cost, rendered otherwise: aa_depth()),
+ * renders retried or started early, and those planned at under LEARN_MIN
+ * seconds of samples, whose CPU is mostly POV-Ray's start.  The base pass's
+ * one frame gives the map's start, 1 everywhere.  A sample of
+ * glossy_reflection's reflecting floor costs 14 times one of its sky and
+ * wall (the lower and upper halves at twice 160x120, `povray
+ * scenes/glossy_reflection.pov +W320 +H240 -A +SR121 +ER240 +WT1`, 1.13
+ * and 0.08 CPU s, 2026-12-02): planned at the frame's average, its pass 2
+ * under --budget 3 took twice its plan on the floor and lost one or two of
+ * five or six region renders at the deadline in each of four runs; the
+ * global correction the map replaced (the pass's CPU over its plan, for
+ * every pixel) learnt nothing where pass 1 was the frame.
+ */
+#define LEARN_MAX 8.0
+#define LEARN_MIN 0.02
+#define COST_MIN 0.02
+#define COST_MAX 50.0
+static void learn_costs(struct run *r, const struct plan_params *pp, const struct plan *pl,
+			const struct pov_result *res)
+{
+	if (!r->cost_map)
+		return;
+	const double px = (double)r->w * r->h;
+	double lo = INFINITY, hi = 0.0;
+	int nl = 0;
+	for (size_t k = 0; k < pl->nregions; k++) {
+		const struct plan_region *g = &pl->regions[k];
+		if (g->scale == ACC_AA || res[k].attempts != 1 || res[k].prelaunched)
+			continue;
+		const double jc = plan_job_cost(pp, g->scale, px);
+		const double planned = g->cost - jc, used = res[k].cpu_s - jc;
+		if (!(planned >= LEARN_MIN) || !(used > 0.0))
+			continue;
+		double q = used / planned;
+		if (res[k].status != POV_OK && !(res[k].status == POV_CANCELLED && q > 1.0))
+			continue;
+		q = q < 1.0 / LEARN_MAX ? 1.0 / LEARN_MAX : q > LEARN_MAX ? LEARN_MAX : q;
+		lo = q < lo ? q : lo;
+		hi = q > hi ? q : hi;
+		nl++;
+		for (int y = g->y0; y <= g->y1; y++)
+			for (int x = g->x0; x <= g->x1; x++) {
+				float *c = &r->cost_map[(size_t)y * r->w + x];
+				double v = *c * q;
+				*c = (float)(v < COST_MIN ? COST_MIN : v > COST_MAX ? COST_MAX : v);
+			}
+	}
+	r->cost_learnt += nl;
+	if (nl && r->verbose)
+		progress(r, "pass %d: %d region renders took %.2g to %.2g times their planned "
+			 "CPU, their pixels' costs so scaled", r->pool_pass, nl, lo, hi);
+}
+
+/*
  * One refinement pass from the error estimate r->est.  Returns 0 when a
  * pass ran, PASS_STOP when the planner stopped the run (r->stop says why),
  * -1 on failure, POV_INTERRUPTED when a signal came.
@@ -1711,8 +1782,9 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		const double lat = early ? r->pre_latency : r->latency;
 		plan_params_init(&pp);
 		pp.target = r->target;
-		pp.cost_job = r->cost_job * cost_scale(r);
-		pp.cost_sample = r->cost_sample * cost_scale(r);
+		pp.cost_job = r->cost_job;
+		pp.cost_sample = r->cost_sample;
+		pp.cost_map = r->cost_map;
 		pp.max_regions = r->jobs > 8 ? r->jobs : 8;
 		if (r->budget > 0.0) {
 			double left = r->budget - elapsed(r);
@@ -1736,9 +1808,9 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		pp.grid = choose ? PLAN_GRID_ONLY : run_grid(r);
 		if (r->focal) {	/* scaled frames up to 8 Mpixels: their cost shows */
 			pp.grid_frame = PLAN_FOCAL_FRAME;
-			pp.cost_frame = FRAME_COST * cost_scale(r);
+			pp.cost_frame = FRAME_COST;
 		}
-		pp.min_split = r->cores;
+		pp.min_split = r->budget > 0.0 ? 2 * r->cores : r->cores;
 		/* under a budget, a pass that leaves the target unmet and
 		 * would take less than 1% of the error off is not worth
 		 * POV-Ray's wait (a budget's last seconds: ten pixels) */
@@ -1905,17 +1977,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		if (!r->keep)
 			unlink(outs[k]);
 	}
-	/* the plan's costs against the CPU of what rendered */
-	double predicted = 0.0, used = 0.0;
-	for (size_t k = 0; k < n; k++)
-		if (results[k].status == POV_OK) {
-			predicted += pl.regions[k].cost;
-			used += results[k].cpu_s;
-		}
-	if (predicted > 0.05 && used > 0.0) {
-		double q = used / (predicted / cost_scale(r));
-		r->cost_corr = q < 0.5 ? 0.5 : q > 4.0 ? 4.0 : q;
-	}
+	learn_costs(r, &pp, &pl, results);
 	if (stopped) {
 		progress(r, "pass %d: %d of %zu region renders stopped at the budget's end, "
 			 "their samples lost", pass, stopped, n);
@@ -2022,7 +2084,6 @@ int cmd_render(int argc, char **argv)
 	r.grid = PLAN_GRID_LARGE;
 	r.prelaunch = PRE_AUTO;
 	r.pre_latency = PRE_LATENCY;
-	r.cost_corr = 1.0;
 	char emap[PATH_MAX], wdir[PATH_MAX];
 
 	int i = 1;
@@ -2235,7 +2296,10 @@ bad:
 	r.est = malloc((size_t)r.w * r.h * sizeof(*r.est));
 	r.noise = malloc((size_t)r.w * r.h * sizeof(*r.noise));
 	r.take = malloc((size_t)r.w * r.h * sizeof *r.take);
-	if (!r.est || !r.noise || !r.take) {
+	if (r.budget > 0.0 && (r.cost_map = malloc((size_t)r.w * r.h * sizeof *r.cost_map)))
+		for (size_t q = 0; q < (size_t)r.w * r.h; q++)
+			r.cost_map[q] = 1.0f;
+	if (!r.est || !r.noise || !r.take || (r.budget > 0.0 && !r.cost_map)) {
 		errbuf_printf(err, sizeof err, "out of memory");
 		goto fail;
 	}
@@ -2367,5 +2431,6 @@ done:
 	free(r.est);
 	free(r.noise);
 	free(r.take);
+	free(r.cost_map);
 	return ret;
 }
