@@ -530,8 +530,8 @@ static int cost_half(const struct plan_params *p, const struct plan_region *r, i
 }
 
 /*
- * Split the dearest region in two (across its longer side, or with a cost
- * map as plan_params says) while it costs
+ * Split the dearest region in two across its longer side (at its middle,
+ * or with a cost map where its cost halves) while it costs
  * more than the pass over p->min_split, renders more than four
  * invocations' worth of samples, and the plan has fewer than twice
  * p->max_regions: so that the cores finish together.  (With the cap at
@@ -555,18 +555,17 @@ static int split_regions(const struct plan_params *p, struct plan *out, const un
 		struct plan_region a = out->regions[d], b = a;
 		int rw = a.x1 - a.x0 + 1, rh = a.y1 - a.y0 + 1;
 		const double jc = job_cost(p, a.scale, plan_px(out));
-		if (a.cost <= total / p->min_split || a.cost - jc < 4.0 * jc ||
+		/* (a tolerance: costs summed from a cost map's table are not
+		 * exact, and parts of equal cost must not split again) */
+		if (a.cost <= total / p->min_split * (1.0 + 1e-9) || a.cost - jc < 4.0 * jc ||
 		    (rw < 2 && rh < 2))
 			break;
+		/* b is still the whole region here: the cut halves its cost */
 		if (rh >= rw) {
-			a.y1 = a.y0 + rh / 2 - 1;
-			if (p->cost_map)
-				a.y1 = cost_half(p, &a, 1);
+			a.y1 = p->cost_map ? cost_half(p, &b, 1) : a.y0 + rh / 2 - 1;
 			b.y0 = a.y1 + 1;
 		} else {
-			a.x1 = a.x0 + rw / 2 - 1;
-			if (p->cost_map)
-				a.x1 = cost_half(p, &a, 0);
+			a.x1 = p->cost_map ? cost_half(p, &b, 0) : a.x0 + rw / 2 - 1;
 			b.x0 = a.x1 + 1;
 		}
 		region_count(p, &a, out, ps, gain);

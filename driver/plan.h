@@ -65,10 +65,9 @@ struct plan_params {
 				 * its region renders under a budget).  With a
 				 * map, candidates, upgrades and rectangles are
 				 * costed by it, and a region is split across
-				 * its rows where its cost halves (across its
-				 * columns when more than twice as wide as
-				 * tall); NULL (default): 1 everywhere, split
-				 * across the longer side at its middle */
+				 * its longer side where its cost halves;
+				 * NULL (default): 1 everywhere, split across
+				 * the longer side at its middle */
 	/* set by the planner from cost_map: its summed-area table,
 	 * (w + 1) x (h + 1), and w */
 	const double *cost_sat;

@@ -1353,6 +1353,99 @@ static void test_plan_budget(void **state)
 	free(in);
 }
 
+/* Region r's cost by a cost map, as plan.h models it. */
+static double map_cost(const struct plan_region *r, const struct plan_params *p,
+		       const float *map)
+{
+	double m = 0.0;
+
+	for (int y = r->y0; y <= r->y1; y++)
+		for (int x = r->x0; x <= r->x1; x++)
+			m += map[y * PW + x];
+	return p->cost_job + p->cost_sample * m * r->scale * r->scale;
+}
+
+/* 7b. A cost map: under a budget the cheap pixels go first at equal error,
+ * regions cost their pixels' costs, and the frame is split for the cores
+ * where its cost halves. */
+static void test_plan_cost_map(void **state)
+{
+	static const int all[1][4] = { { 0, 0, PW - 1, PH - 1 } };
+	static float map[PW * PH];
+	struct plan_params p;
+	struct plan_input *in = plan_setup(&p);
+	struct plan pl;
+
+	(void)state;
+	image_release(&in->acc);
+	plan_input(in, all, 1, 0.05f);
+	/* the right half nine times as dear a sample */
+	for (int y = 0; y < PH; y++)
+		for (int x = 0; x < PW; x++)
+			map[y * PW + x] = x < PW / 2 ? 1.0f : 9.0f;
+	p.target = 1e-6;
+	p.cost_job = 0.001;
+	p.budget = 0.015;	/* the left half at scale 2: 0.0123 s */
+	/* without the map the budget's pixels come by position, from both
+	 * halves */
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	long right = 0;
+	for (int y = 0; y < PH; y++)
+		for (int x = PW / 2; x < PW; x++)
+			right += pl.chosen[y * PW + x] > 0.0f;
+	assert_true(right > 0);
+	plan_release(&pl);
+	/* with it, the left half alone, costed by the map within the budget */
+	p.cost_map = map;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	check_regions(&pl, &p);
+	long left = 0;
+	double c = 0.0;
+	for (int y = 0; y < PH; y++)
+		for (int x = 0; x < PW; x++) {
+			if (x >= PW / 2)
+				assert_true(pl.scale[y * PW + x] == 0.0f);
+			else
+				left += pl.chosen[y * PW + x] > 0.0f;
+		}
+	assert_true(left > PW / 2 * PH / 2);
+	for (size_t k = 0; k < pl.nregions; k++) {
+		assert_close(pl.regions[k].cost, map_cost(&pl.regions[k], &p, map), 1e-9, 0.0,
+			     "a region's cost by the map");
+		c += pl.regions[k].cost;
+	}
+	assert_close(pl.cost, c, 1e-9, 0.0, "the plan's cost");
+	assert_true(pl.cost <= p.budget);
+	plan_release(&pl);
+
+	/* no budget, two cores: columns 0-15 three times as dear as the rest
+	 * hold half the frame's cost, and the split falls after column 15 */
+	for (int y = 0; y < PH; y++)
+		for (int x = 0; x < PW; x++)
+			map[y * PW + x] = x < 16 ? 3.0f : 1.0f;
+	p.budget = 0.0;
+	p.min_split = 2;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	check_regions(&pl, &p);
+	assert_int_equal(pl.nregions, 2);
+	assert_int_equal(pl.pixels, PW * PH);
+	assert_int_equal(pl.regions[0].x0, 0);
+	assert_int_equal(pl.regions[0].x1, 15);
+	assert_int_equal(pl.regions[1].x0, 16);
+	assert_close(pl.regions[0].cost, pl.regions[1].cost, 1e-9, 0.0, "the parts' costs");
+	assert_close(pl.regions[0].cost, map_cost(&pl.regions[0], &p, map), 1e-9, 0.0,
+		     "the dear part's cost");
+	plan_release(&pl);
+	/* and at the middle without the map */
+	p.cost_map = NULL;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	assert_int_equal(pl.nregions, 2);
+	assert_int_equal(pl.regions[0].x1, PW / 2 - 1);
+	plan_release(&pl);
+	image_release(&in->acc);
+	free(in);
+}
+
 static double want_bias(const float *o)
 {
 	double a = 0.0, b = 0.0;
@@ -2001,6 +2094,7 @@ int main(void)
 		cmocka_unit_test(test_read_rows),
 		cmocka_unit_test(test_plan_make),
 		cmocka_unit_test(test_plan_budget),
+		cmocka_unit_test(test_plan_cost_map),
 		cmocka_unit_test(test_pixel_errors),
 		cmocka_unit_test(test_pixel_errors_threads),
 		cmocka_unit_test(test_final_choice),
