@@ -510,22 +510,31 @@ static void region_count(const struct plan_params *p, struct plan_region *r,
 	r->cost = rect_cost(p, r, plan_px(out));
 }
 
+/* The cost map's sum over region r's first rows (rows) or columns, up to
+ * and including m. */
+static double head_sum(const struct plan_params *p, const struct plan_region *r, int rows, int m)
+{
+	return rows ? map_sum(p, r->x0, r->y0, r->x1, m) : map_sum(p, r->x0, r->y0, m, r->y1);
+}
+
 /* The last row (rows) or column of region r's first part when it is cut
- * where the cost map's sum over it halves, both parts one or more wide. */
+ * where the cost map's sum over it comes nearest to halving, both parts one
+ * or more wide. */
 static int cost_half(const struct plan_params *p, const struct plan_region *r, int rows)
 {
 	const int lo = rows ? r->y0 : r->x0, hi = rows ? r->y1 : r->x1;
 	const double half = 0.5 * map_sum(p, r->x0, r->y0, r->x1, r->y1);
-	int a = lo, b = hi - 1;	/* the answer lies in a..b */
+	int a = lo, b = hi - 1;	/* the first cut reaching half lies in a..b */
 	while (a < b) {
 		int m = a + (b - a) / 2;
-		double c = rows ? map_sum(p, r->x0, r->y0, r->x1, m) :
-				  map_sum(p, r->x0, r->y0, m, r->y1);
-		if (c < half)
+		if (head_sum(p, r, rows, m) < half)
 			a = m + 1;
 		else
 			b = m;
 	}
+	/* or the one before it, if nearer (a dear row straddling the half) */
+	if (a > lo && half - head_sum(p, r, rows, a - 1) < head_sum(p, r, rows, a) - half)
+		a--;
 	return a;
 }
 
@@ -555,9 +564,10 @@ static int split_regions(const struct plan_params *p, struct plan *out, const un
 		struct plan_region a = out->regions[d], b = a;
 		int rw = a.x1 - a.x0 + 1, rh = a.y1 - a.y0 + 1;
 		const double jc = job_cost(p, a.scale, plan_px(out));
-		/* (a tolerance: costs summed from a cost map's table are not
-		 * exact, and parts of equal cost must not split again) */
-		if (a.cost <= total / p->min_split * (1.0 + 1e-9) || a.cost - jc < 4.0 * jc ||
+		/* (with a map a tolerance: costs summed from its table are
+		 * not exact, and parts of equal cost must not split again) */
+		const double share = total / p->min_split * (p->cost_map ? 1.0 + 1e-9 : 1.0);
+		if (a.cost <= share || a.cost - jc < 4.0 * jc ||
 		    (rw < 2 && rh < 2))
 			break;
 		/* b is still the whole region here: the cut halves its cost */
@@ -769,16 +779,6 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	struct plan_params pm = *pin;
 	const struct plan_params *p = &pm;
 	double *sat = NULL;
-	pm.cost_sat = NULL;
-	pm.cost_sat_w = w;
-	if (pm.cost_map) {
-		if (!(sat = map_table(pm.cost_map, w, h))) {
-			memset(out, 0, sizeof(*out));
-			errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
-			return -1;
-		}
-		pm.cost_sat = sat;
-	}
 	int ret = -1;
 
 	memset(out, 0, sizeof(*out));
@@ -788,6 +788,15 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	    p->max_regions < 1 || p->tile < 1) {
 		errbuf_printf(err, errlen, "bad planning parameters");
 		return -1;
+	}
+	pm.cost_sat = NULL;
+	pm.cost_sat_w = w;
+	if (pm.cost_map) {
+		if (!(sat = map_table(pm.cost_map, w, h))) {
+			errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
+			return -1;
+		}
+		pm.cost_sat = sat;
 	}
 	gain = calloc(npx, sizeof(*gain));
 	cand = malloc(npx * sizeof(*cand));

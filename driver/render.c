@@ -70,7 +70,9 @@ static const char usage_options[] =
 	"                        region renders still running when only the time\n"
 	"                        to merge, analyse and write the final image is\n"
 	"                        left are stopped; a base pass still running at its\n"
-	"                        end is stopped and the run fails, with no image)\n"
+	"                        end is stopped and the run fails, with no image;\n"
+	"                        its passes cost each pixel as the region renders\n"
+	"                        before them measured it)\n"
 	"  --max-passes N        refinement passes after the base pass (default 8)\n"
 	"  --prelaunch auto|on|off\n"
 	"                        start each pass's likely region renders during the\n"
@@ -103,7 +105,8 @@ static const char usage_options[] =
 	"                        relerror, samples, order, bandwidth, pass, scales,\n"
 	"                        fit (the share of the regression's fit OUT.exr\n"
 	"                        holds)\n"
-	"  --report FILE         JSON report of every pass (default: none)\n"
+	"  --report FILE         JSON report of every pass (default: none)\n";
+static const char usage_options2[] =
 	"  --sampler S           how pixels get their samples: auto (default: grid for\n"
 	"                        the scales whose scaled frame would exceed 1 Mpixel,\n"
 	"                        scale below, or 8 Mpixels for a scene whose file has\n"
@@ -120,8 +123,7 @@ static const char usage_options[] =
 	"                        the cores, as jitter), grid\n"
 	"                        (scales 4, 8 and 16 as renders at twice the size with\n"
 	"                        POV-Ray's +AM1 +A0.0 +R(scale/2) +J0.75: scale x\n"
-	"                        scale jittered samples), scale (resolution scaling\n";
-static const char usage_options2[] =
+	"                        scale jittered samples), scale (resolution scaling\n"
 	"                        throughout: the render is scale times the size,\n"
 	"                        which POV-Ray pays for per render whatever the\n"
 	"                        region), aa (scaling,\n"
@@ -701,11 +703,12 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 	fprintf(f, "  \"budget\": %.6g,\n  \"stop\": ", r->budget);
 	json_str(f, r->stop ? r->stop : "");
 	fprintf(f, ",\n  \"cost_model\": {\"job_s\": %.17g, \"sample_s\": %.17g, "
-		"\"latency_s\": %.6g, \"scale\": %.4g},\n  \"radiosity\": %s,\n"
+		"\"latency_s\": %.6g, \"scale\": %.4g, \"learnt\": %d},\n  \"radiosity\": %s,\n"
 		"  \"radiosity_scale\": %d,\n  \"focal_blur\": %s,\n  \"povwait\": %s,\n"
 		"  \"sampler\": \"%s\",\n  \"sampler_chosen\": \"%s\",\n  \"prelaunch\": \"%s\",\n"
 		"  \"final\": \"%s\",\n  \"passes\": [\n",
-		r->cost_job, r->cost_sample, r->latency, cost_map_mean(r), r->radiosity ? "true" : "false",
+		r->cost_job, r->cost_sample, r->latency, cost_map_mean(r), r->cost_learnt,
+		r->radiosity ? "true" : "false",
 		r->rad_scale, r->focal ? "true" : "false", pov_wait_library() ? "true" : "false",
 		r->aa ? "aa" : plan_grid_name(r->grid),
 		r->aa ? "aa" : plan_grid_name(run_grid(r)),
@@ -1599,8 +1602,8 @@ static double edge_render_cost(const struct run *r, const struct plan_params *pp
  * for 11,416 pixels) and by
  * edge_render_cost() at 1.35 core-s, its dearest render 0.68 s, ran past
  * the deadline 1.56 s on and lost that render: relMSE 9.0e-4 against
- * +R3's 2.8e-5.  The regions keep scale 2's cost for the plan (the pass's
- * cost correction for the next passes is measured against it as before).
+ * +R3's 2.8e-5.  The regions keep scale 2's cost for the plan (and the
+ * cost map learns nothing from them: learn_costs()).
  */
 #define EDGE_MARGIN 2.0
 static void aa_depth(const struct run *r, struct plan *pl, const struct plan_params *pp,
@@ -1691,8 +1694,11 @@ static double final_reserve(const struct run *r)
  * A render stopped at the deadline took at least its CPU: its pixels' costs
  * grow when that is more than planned.  Not learnt from: antialiased
  * renders (planned at scale 2's cost, rendered otherwise: aa_depth()),
- * renders retried or started early, and those planned at under LEARN_MIN
- * seconds of samples, whose CPU is mostly POV-Ray's start.  The base pass's
+ * renders retried or started early, those planned at under LEARN_MIN
+ * seconds of samples, whose CPU is mostly POV-Ray's start, and a pass whose
+ * regions are the bands of early renders (`covered`: prelaunch_cover()
+ * costs them at the plan's mean, not by the map).  A pixel in regions of
+ * two scales takes their factors' geometric mean.  The base pass's
  * one frame gives the map's start, 1 everywhere.  A sample of
  * glossy_reflection's reflecting floor costs 14 times one of its sky and
  * wall (the lower and upper halves at twice 160x120, `povray
@@ -1708,13 +1714,19 @@ static double final_reserve(const struct run *r)
 #define COST_MIN 0.02
 #define COST_MAX 50.0
 static void learn_costs(struct run *r, const struct plan_params *pp, const struct plan *pl,
-			const struct pov_result *res)
+			const struct pov_result *res, int covered)
 {
-	if (!r->cost_map)
+	if (!r->cost_map || covered)
 		return;
-	const double px = (double)r->w * r->h;
+	const size_t npx = (size_t)r->w * r->h;
+	const double px = (double)npx;
 	double lo = INFINITY, hi = 0.0;
 	int nl = 0;
+	/* each pixel's factors' log sum and count: where regions of two
+	 * scales overlap, each measured its cost against the map as it was,
+	 * and the pixel takes their geometric mean, not their product */
+	double *ls = NULL;
+	unsigned short *nf = NULL;
 	for (size_t k = 0; k < pl->nregions; k++) {
 		const struct plan_region *g = &pl->regions[k];
 		if (g->scale == ACC_AA || res[k].attempts != 1 || res[k].prelaunched)
@@ -1727,16 +1739,30 @@ static void learn_costs(struct run *r, const struct plan_params *pp, const struc
 		if (res[k].status != POV_OK && !(res[k].status == POV_CANCELLED && q > 1.0))
 			continue;
 		q = q < 1.0 / LEARN_MAX ? 1.0 / LEARN_MAX : q > LEARN_MAX ? LEARN_MAX : q;
+		if (!ls && (!(ls = calloc(npx, sizeof(*ls))) || !(nf = calloc(npx, sizeof(*nf)))))
+			break;	/* out of memory: the map stays as it was */
 		lo = q < lo ? q : lo;
 		hi = q > hi ? q : hi;
 		nl++;
+		const double lq = log(q);
 		for (int y = g->y0; y <= g->y1; y++)
 			for (int x = g->x0; x <= g->x1; x++) {
-				float *c = &r->cost_map[(size_t)y * r->w + x];
-				double v = *c * q;
-				*c = (float)(v < COST_MIN ? COST_MIN : v > COST_MAX ? COST_MAX : v);
+				const size_t i = (size_t)y * r->w + x;
+				ls[i] += lq;
+				nf[i]++;
 			}
 	}
+	if (ls && nf)
+		for (size_t i = 0; i < npx; i++) {
+			if (!nf[i])
+				continue;
+			double v = r->cost_map[i] * exp(ls[i] / nf[i]);
+			r->cost_map[i] = (float)(v < COST_MIN ? COST_MIN : v > COST_MAX ? COST_MAX : v);
+		}
+	else
+		nl = 0;
+	free(ls);
+	free(nf);
 	r->cost_learnt += nl;
 	if (nl && r->verbose)
 		progress(r, "pass %d: %d region renders took %.2g to %.2g times their planned "
@@ -1977,7 +2003,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		if (!r->keep)
 			unlink(outs[k]);
 	}
-	learn_costs(r, &pp, &pl, results);
+	learn_costs(r, &pp, &pl, results, pre_idx != NULL);
 	if (stopped) {
 		progress(r, "pass %d: %d of %zu region renders stopped at the budget's end, "
 			 "their samples lost", pass, stopped, n);

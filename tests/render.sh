@@ -631,6 +631,20 @@ check "... and it ends within the 4 s budget ($dt s)" num 'a <= 4.3' "$dt"
 check "... the output is a complete image" valid_exr "$T/dl.exr"
 check "... no POV-Ray child left" no_povray_left "$T/dl work"
 
+# --- under a budget the planner learns each pixel's cost from its renders ----
+# glossy_reflection's floor costs many times its sky a sample: the first
+# pass's region renders (scale 2 over the frame, split for the cores) teach
+# the cost map, whose mean the report gives; without a budget there is none
+"$PP" render "$SC/glossy_reflection.pov" -o "$T/cm.exr" -W 160 -H 120 --budget 3 \
+	--target 1e-6 -v --report "$T/cm.json" 2>"$T/cm.err"
+check "cost map: a budget run succeeds" test $? -eq 0
+cml=$(jget "$T/cm.json" learnt)
+cms=$(grep -o '"scale": [-0-9.e+]*, "learnt"' "$T/cm.json" | awk '{ print $2 }' | tr -d ,)
+check "... it learnt from region renders ($cml)" num 'a >= 1' "${cml:-0}"
+check "... and says so" grep -q "times their planned CPU, their pixels' costs so scaled" "$T/cm.err"
+check "... the map moved off the base pass's mean ($cms)" num 'a != 1' "${cms:-1}"
+check "... a run without a budget learns nothing" grep -q '"scale": 1, "learnt": 0}' "$T/one.json"
+
 # a base pass longer than the budget (media at 1280x960: 64 times its
 # 160x120 base pass, 0.37 CPU s in the sweep, so some 23 CPU s) is stopped
 # at the budget's end: an error naming the budget, no image, nothing left
