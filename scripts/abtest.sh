@@ -6,16 +6,20 @@
 # povpress's plans hang on the timings it measures, so a change is judged by
 # turns in one session, never against figures from another.
 #
-# usage: scripts/abtest.sh [--runs N] [--size WxH] BUILD_A BUILD_B [SCENE ...]
+# usage: scripts/abtest.sh [--runs N] [--size WxH] [--ref-scale S] BUILD_A BUILD_B
+#                          [SCENE ...]
 #
 # BUILD_A, BUILD_B: build directories holding povpress and povwait.so (for
 # an older commit: git worktree add /tmp/a COMMIT && make -C /tmp/a).
-# SCENE: names of bundled scenes (default: every scenes/*.pov but
-# smooth_empty).  SETTINGS (environment) lists the render settings,
-# separated by ';' (default "--budget 2;--budget 4;--budget 8"); a budget
-# setting also gets --target 1e-6, as in make sweep.  --runs N (default 2)
-# runs of each build per setting.  Needs make sweep's scale-25 references
-# at the size (default 160x120) in ${POVPRESS_CACHE:-$HOME/.cache/povpress}/ref.
+# SCENE: names of bundled scenes, or paths of any .pov files (default: every
+# scenes/*.pov but smooth_empty).  SETTINGS (environment) lists the render
+# settings, separated by ';' (default "--budget 2;--budget 4;--budget 8"); a
+# budget setting also gets --target 1e-6, as in make sweep.  --runs N
+# (default 2) runs of each build per setting.  The reference of scene NAME
+# is the newest ${POVPRESS_CACHE:-$HOME/.cache/povpress}/ref/NAME-WxH-sS-*.exr
+# at the size (default 160x120) and scale S (--ref-scale, default 25): make
+# sweep's references (scripts/sweep.sh --quick SCENE.pov makes them at 15, 9
+# and 5 for any scene).
 #
 # Prints a line per run and, per scene and setting, the geometric means of
 # both builds' relMSE and CPU and their ratio B/A; at the end the geometric
@@ -24,13 +28,14 @@
 set -euo pipefail
 
 usage() {
-	sed -n 's/^# \{0,1\}//; 9p' "$0"
+	sed -n 's/^# \{0,1\}//; 9,10p' "$0"
 }
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 CACHE=${POVPRESS_CACHE:-$HOME/.cache/povpress}/ref
 runs=2
 size=160x120
+rscale=25
 args=()
 while (($#)); do
 	case $1 in
@@ -44,6 +49,11 @@ while (($#)); do
 		size=$2
 		shift
 		;;
+	--ref-scale)
+		[[ $# -ge 2 ]] || { echo "abtest: --ref-scale needs a scale" >&2; exit 2; }
+		rscale=$2
+		shift
+		;;
 	-h | --help) usage; exit 0 ;;
 	-*) echo "abtest: unknown option '$1'" >&2; usage >&2; exit 2 ;;
 	*) args+=("$1") ;;
@@ -52,6 +62,7 @@ while (($#)); do
 done
 ((${#args[@]} >= 2)) || { usage >&2; exit 2; }
 [[ $runs =~ ^[1-9]$ ]] || { echo "abtest: invalid --runs '$runs': expected 1 to 9" >&2; exit 2; }
+[[ $rscale =~ ^[1-9][0-9]?$ ]] || { echo "abtest: invalid --ref-scale '$rscale'" >&2; exit 2; }
 [[ $size =~ ^([1-9][0-9]{0,4})x([1-9][0-9]{0,4})$ ]] ||
 	{ echo "abtest: invalid size '$size': expected WxH, as 160x120" >&2; exit 2; }
 W=${BASH_REMATCH[1]}
@@ -71,14 +82,24 @@ if ((${#scenes[@]} == 0)); then
 fi
 IFS=';' read -r -a settings <<<"${SETTINGS:---budget 2;--budget 4;--budget 8}"
 
-declare -A refs=()
+declare -A refs=() paths=()
+names=()
 for sc in "${scenes[@]}"; do
-	[[ -f $ROOT/scenes/$sc.pov ]] || { echo "abtest: no scene 'scenes/$sc.pov'" >&2; exit 1; }
+	if [[ $sc == *.pov ]]; then
+		path=$sc
+		sc=$(basename "$sc" .pov)
+	else
+		path=$ROOT/scenes/$sc.pov
+	fi
+	[[ -f $path && -r $path ]] || { echo "abtest: cannot read scene '$path'" >&2; exit 1; }
 	# the newest reference at the size (an edited scene gets a new one)
-	ref=$(ls -t "$CACHE/$sc-${W}x$H-s25-"*.exr 2>/dev/null | head -n 1 || true)
-	[[ -n $ref ]] || { echo "abtest: no reference for $sc at ${W}x$H in $CACHE (make sweep)" >&2; exit 1; }
+	ref=$(ls -t "$CACHE/$sc-${W}x$H-s$rscale-"*.exr 2>/dev/null | head -n 1 || true)
+	[[ -n $ref ]] || { echo "abtest: no scale-$rscale reference for $sc at ${W}x$H in $CACHE (make sweep)" >&2; exit 1; }
 	refs[$sc]=$ref
+	paths[$sc]=$path
+	names+=("$sc")
 done
+scenes=("${names[@]}")
 
 OUT=${OUT:-$ROOT/build/abtest}
 mkdir -p "$OUT"
@@ -101,7 +122,7 @@ for sc in "${scenes[@]}"; do
 				b=$A
 				[[ $ab == B ]] && b=$B
 				d=$T/run
-				"$b/povpress" render "$ROOT/scenes/$sc.pov" -W "$W" -H "$H" -q -o "$d.exr" \
+				"$b/povpress" render "${paths[$sc]}" -W "$W" -H "$H" -q -o "$d.exr" \
 					--report "$d.json" "${opt[@]}"
 				rel=$("$b/povpress" compare "$d.exr" "${refs[$sc]}" | awk '$1 == "relmse:" { print $2 }')
 				cpu=$(field "$d.json" all_cpu_s)
