@@ -1101,6 +1101,18 @@ static enum plan_outcome plan_of(struct plan_input *in, const struct plan_params
 	return pl->outcome;
 }
 
+/* The plan of the whole frame with no budget and two cores, which must be
+ * two regions covering it. */
+static void plan_two_parts(struct plan_input *in, struct plan_params *p, struct plan *pl)
+{
+	p->budget = 0.0;
+	p->min_split = 2;
+	assert_int_equal(plan_of(in, p, pl), PLAN_REFINE);
+	check_regions(pl, p);
+	assert_int_equal(pl->nregions, 2);
+	assert_int_equal(pl->pixels, PW * PH);
+}
+
 /* A block of 6 x 5 pixels with error, for the planner's tests. */
 static const int block[1][4] = { { 20, 17, 25, 21 } };
 
@@ -1335,12 +1347,7 @@ static void test_plan_budget(void **state)
 	plan_release(&pl);
 
 	/* no budget, two cores: the frame in two halves of equal cost */
-	p.budget = 0.0;
-	p.min_split = 2;
-	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
-	check_regions(&pl, &p);
-	assert_int_equal(pl.nregions, 2);
-	assert_int_equal(pl.pixels, PW * PH);
+	plan_two_parts(in, &p, &pl);
 	assert_int_equal(pl.chosen_pixels, PW * PH);
 	assert_close(pl.regions[0].cost, pl.regions[1].cost, 1e-9, 0.0, "halves' costs");
 	plan_release(&pl);
@@ -1423,12 +1430,7 @@ static void test_plan_cost_map(void **state)
 	for (int y = 0; y < PH; y++)
 		for (int x = 0; x < PW; x++)
 			map[y * PW + x] = x < 16 ? 3.0f : 1.0f;
-	p.budget = 0.0;
-	p.min_split = 2;
-	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
-	check_regions(&pl, &p);
-	assert_int_equal(pl.nregions, 2);
-	assert_int_equal(pl.pixels, PW * PH);
+	plan_two_parts(in, &p, &pl);
 	assert_int_equal(pl.regions[0].x0, 0);
 	assert_int_equal(pl.regions[0].x1, 15);
 	assert_int_equal(pl.regions[1].x0, 16);
