@@ -1989,7 +1989,7 @@ static void test_plan_job(void **state)
 	assert_aa_options(&job, "+AM2", "+A0.1", "+R3", "+J");
 	/* at the depth it was given (render.c, aa_depth()) */
 	for (int d = 1; d <= ACC_AA_DEPTH; d++) {
-		char want[8];
+		char want[16];
 		snprintf(want, sizeof(want), "+R%d", d);
 		r.depth = d;
 		plan_job(&base, &r, "out/a2.exr", &region, aextra, &job);
