@@ -1689,7 +1689,8 @@ static double final_reserve(const struct run *r)
  * Under a budget, the cost map from what a pass's region renders took: a
  * region's CPU less its invocation's, over the cost the plan gave its
  * samples, scales its pixels' costs (within 1/LEARN_MAX and LEARN_MAX a
- * pass, the map within COST_MIN and COST_MAX), so that the next plans
+ * pass, the map within COST_MIN and COST_MAX; a factor below 1 by its
+ * square root), so that the next plans
  * cost each pixel as its own renders did, not at the base pass's average.
  * A render stopped at the deadline took at least its CPU: its pixels' costs
  * grow when that is more than planned.  Not learnt from: antialiased
@@ -1744,7 +1745,10 @@ static void learn_costs(struct run *r, const struct plan_params *pp, const struc
 		lo = q < lo ? q : lo;
 		hi = q > hi ? q : hi;
 		nl++;
-		const double lq = log(q);
+		/* cheaper than planned, halfway (in the log): a region's mean
+		 * hides its dear parts, and a later render of those planned
+		 * too cheap runs into the deadline and is lost */
+		const double lq = q < 1.0 ? 0.5 * log(q) : log(q);
 		for (int y = g->y0; y <= g->y1; y++)
 			for (int x = g->x0; x <= g->x1; x++) {
 				const size_t i = (size_t)y * r->w + x;

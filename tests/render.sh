@@ -615,13 +615,15 @@ fi
 # --- a budget is a deadline: a pass planned far over it is stopped in time ----
 # --cost-sample 1e-9: the planner thinks samples free and plans a pass that
 # would take many times the budget (--prelaunch off: a pass that takes
-# renders started early leaves its dearer regions to the next).  4 s: the
-# second pass, the one planned free, starts when the first ends by about
-# 2 s (at 3 s one of two fresh-clone runs ended after the first pass, by
-# the measured reserve, and stopped nothing)
+# renders started early leaves its dearer regions to the next).  One pass
+# at 480x360 after a base pass of about 1 s: the frame at scale 4, about 30
+# CPU s on one POV-Ray process (2026-12-03), which a machine ten times as
+# fast would not finish in the 3 s left.  (At 80x60 the pass planned free was the second, and on a
+# machine fast enough to finish it a third was not started within the
+# reserve: nothing stopped, one run of four.)
 t0=$EPOCHREALTIME
-"$PP" render "$SC/media.pov" -o "$T/dl.exr" -W 80 -H 60 --budget 4 --target 1e-6 \
-	--cost-sample 1e-9 --prelaunch off --workdir "$T/dl work" -v 2>"$T/dl.err"
+"$PP" render "$SC/media.pov" -o "$T/dl.exr" -W 480 -H 360 --budget 4 --target 1e-6 \
+	--cost-sample 1e-9 --prelaunch off --max-passes 1 --workdir "$T/dl work" -v 2>"$T/dl.err"
 rc=$?
 dt=$(awk -v a="$t0" -v b="$EPOCHREALTIME" 'BEGIN { printf "%.2f", b - a }')
 check "budget deadline: a run whose pass is planned as free succeeds" test $rc -eq 0
