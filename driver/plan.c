@@ -193,8 +193,19 @@ double plan_job_cost(const struct plan_params *p, int s, double px)
 	return job_cost(p, s, px);
 }
 
-/* The cost map's sum over pixels x0..x1 x y0..y1 (inclusive): their area
- * without a map. */
+double plan_region_map(const struct plan_params *p, const struct plan_region *r, int w)
+{
+	if (!p->cost_map)
+		return (double)plan_region_area(r);
+	double m = 0.0;
+	for (int y = r->y0; y <= r->y1; y++)
+		for (int x = r->x0; x <= r->x1; x++)
+			m += p->cost_map[(size_t)y * w + x];
+	return m;
+}
+
+/* The cost map's sum over pixels x0..x1 x y0..y1 (inclusive) from its
+ * summed-area table: their area without a map. */
 static double map_sum(const struct plan_params *p, int x0, int y0, int x1, int y1)
 {
 	if (!p->cost_sat)
@@ -564,10 +575,9 @@ static int split_regions(const struct plan_params *p, struct plan *out, const un
 		struct plan_region a = out->regions[d], b = a;
 		int rw = a.x1 - a.x0 + 1, rh = a.y1 - a.y0 + 1;
 		const double jc = job_cost(p, a.scale, plan_px(out));
-		/* (with a map a tolerance: costs summed from its table are
-		 * not exact, and parts of equal cost must not split again) */
-		const double share = total / p->min_split * (p->cost_map ? 1.0 + 1e-9 : 1.0);
-		if (a.cost <= share || a.cost - jc < 4.0 * jc ||
+		/* (a tolerance: costs are sums, not exact, and parts of equal
+		 * cost must not split again) */
+		if (a.cost <= total / p->min_split * (1.0 + 1e-9) || a.cost - jc < 4.0 * jc ||
 		    (rw < 2 && rh < 2))
 			break;
 		/* b is still the whole region here: the cut halves its cost */

@@ -78,6 +78,7 @@ struct plan_params {
  * invocation and, with cost_frame, its frame. */
 double plan_job_cost(const struct plan_params *p, int s, double px);
 
+
 /* Grid renders: never (resolution scaling), for every scale of 4 or more,
  * or for those whose scaled frame would exceed grid_frame pixels
  * (PLAN_GRID_FRAME, or PLAN_FOCAL_FRAME where render's --sampler auto finds
@@ -130,6 +131,11 @@ static inline long plan_region_area(const struct plan_region *r)
 {
 	return (long)(r->x1 - r->x0 + 1) * (r->y1 - r->y0 + 1);
 }
+
+/* The cost map's sum over region r of an image w pixels wide (each pixel's
+ * cost a sample over cost_sample): r's area without a map.  A region's
+ * samples cost cost_sample * scale^2 times this. */
+double plan_region_map(const struct plan_params *p, const struct plan_region *r, int w);
 
 enum plan_outcome {
 	PLAN_REFINE,		/* regions to render */

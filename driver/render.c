@@ -1574,15 +1574,8 @@ static double edge_render_cost(const struct run *r, const struct plan_params *pp
 			e += edge;
 		}
 	const double f2 = (double)ACC_GRID_FRAME * ACC_GRID_FRAME;
-	double m = 0.0;	/* the region's cost a sample, the cost map's mean */
-	if (pp->cost_map) {
-		for (int y = g->y0; y <= g->y1; y++)
-			for (int x = g->x0; x <= g->x1; x++)
-				m += pp->cost_map[(size_t)y * acc->w + x];
-		m /= (double)plan_region_area(g);
-	} else {
-		m = 1.0;
-	}
+	/* the region's cost a sample, the cost map's mean */
+	const double m = plan_region_map(pp, g, acc->w) / (double)plan_region_area(g);
 	return pp->cost_job + pp->cost_sample * m *
 				      (f2 * (double)plan_region_area(g) +
 				       ldexp(EDGE_SAMPLES, d - 4) * (double)e);
@@ -1687,19 +1680,17 @@ static double final_reserve(const struct run *r)
 
 /*
  * Under a budget, the cost map from what a pass's region renders took: a
- * region's CPU less its invocation's, over the cost the plan gave its
- * samples, scales its pixels' costs (within 1/LEARN_MAX and LEARN_MAX a
- * pass, the map within COST_MIN and COST_MAX; a factor below 1 by its
- * square root), so that the next plans
- * cost each pixel as its own renders did, not at the base pass's average.
- * A render stopped at the deadline took at least its CPU: its pixels' costs
- * grow when that is more than planned.  Not learnt from: antialiased
- * renders (planned at scale 2's cost, rendered otherwise: aa_depth()),
- * renders retried or started early, those planned at under LEARN_MIN
- * seconds of samples, whose CPU is mostly POV-Ray's start, and a pass whose
- * regions are the bands of early renders (`covered`: prelaunch_cover()
- * costs them at the plan's mean, not by the map).  A pixel in regions of
- * two scales takes their factors' geometric mean.  The base pass's
+ * region's CPU less its invocation's, over its samples' cost by the map,
+ * scales its pixels' costs (within 1/LEARN_MAX and LEARN_MAX a pass, the
+ * map within COST_MIN and COST_MAX; a factor below 1 by its square root),
+ * so that the next plans cost each pixel as its own renders did, not at
+ * the base pass's average.  A render stopped at the deadline took at least
+ * its CPU: its pixels' costs grow when that is more than planned.  Not
+ * learnt from: antialiased renders (planned at scale 2's cost, rendered
+ * otherwise: aa_depth()), renders retried or started early, and those
+ * planned at under LEARN_MIN seconds of samples, whose CPU is mostly
+ * POV-Ray's start.  A pixel in regions of two scales takes their factors'
+ * geometric mean.  The base pass's
  * one frame gives the map's start, 1 everywhere.  A sample of
  * glossy_reflection's reflecting floor costs 14 times one of its sky and
  * wall (the lower and upper halves at twice 160x120, `povray
@@ -1715,9 +1706,9 @@ static double final_reserve(const struct run *r)
 #define COST_MIN 0.02
 #define COST_MAX 50.0
 static void learn_costs(struct run *r, const struct plan_params *pp, const struct plan *pl,
-			const struct pov_result *res, int covered)
+			const struct pov_result *res)
 {
-	if (!r->cost_map || covered)
+	if (!r->cost_map)
 		return;
 	const size_t npx = (size_t)r->w * r->h;
 	const double px = (double)npx;
@@ -1726,22 +1717,29 @@ static void learn_costs(struct run *r, const struct plan_params *pp, const struc
 	/* each pixel's factors' log sum and count: where regions of two
 	 * scales overlap, each measured its cost against the map as it was,
 	 * and the pixel takes their geometric mean, not their product */
-	double *ls = NULL;
-	unsigned short *nf = NULL;
+	double *ls = calloc(npx, sizeof(*ls));
+	unsigned short *nf = calloc(npx, sizeof(*nf));
+	if (!ls || !nf) {	/* out of memory: the map stays as it was */
+		free(ls);
+		free(nf);
+		return;
+	}
 	for (size_t k = 0; k < pl->nregions; k++) {
 		const struct plan_region *g = &pl->regions[k];
 		if (g->scale == ACC_AA || res[k].attempts != 1 || res[k].prelaunched)
 			continue;
-		const double jc = plan_job_cost(pp, g->scale, px);
-		const double planned = g->cost - jc, used = res[k].cpu_s - jc;
+		/* the samples' cost by the map, not the region's cost less
+		 * its job: an early render's band is costed at its plan's
+		 * mean (prelaunch_cover()) */
+		const double planned = pp->cost_sample * g->scale * g->scale *
+				       plan_region_map(pp, g, r->w),
+			     used = res[k].cpu_s - plan_job_cost(pp, g->scale, px);
 		if (!(planned >= LEARN_MIN) || !(used > 0.0))
 			continue;
 		double q = used / planned;
 		if (res[k].status != POV_OK && !(res[k].status == POV_CANCELLED && q > 1.0))
 			continue;
 		q = q < 1.0 / LEARN_MAX ? 1.0 / LEARN_MAX : q > LEARN_MAX ? LEARN_MAX : q;
-		if (!ls && (!(ls = calloc(npx, sizeof(*ls))) || !(nf = calloc(npx, sizeof(*nf)))))
-			break;	/* out of memory: the map stays as it was */
 		lo = q < lo ? q : lo;
 		hi = q > hi ? q : hi;
 		nl++;
@@ -1756,15 +1754,12 @@ static void learn_costs(struct run *r, const struct plan_params *pp, const struc
 				nf[i]++;
 			}
 	}
-	if (ls && nf)
-		for (size_t i = 0; i < npx; i++) {
-			if (!nf[i])
-				continue;
-			double v = r->cost_map[i] * exp(ls[i] / nf[i]);
-			r->cost_map[i] = (float)(v < COST_MIN ? COST_MIN : v > COST_MAX ? COST_MAX : v);
-		}
-	else
-		nl = 0;
+	for (size_t i = 0; i < npx; i++) {
+		if (!nf[i])
+			continue;
+		double v = r->cost_map[i] * exp(ls[i] / nf[i]);
+		r->cost_map[i] = (float)(v < COST_MIN ? COST_MIN : v > COST_MAX ? COST_MAX : v);
+	}
 	free(ls);
 	free(nf);
 	r->cost_learnt += nl;
@@ -2007,7 +2002,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		if (!r->keep)
 			unlink(outs[k]);
 	}
-	learn_costs(r, &pp, &pl, results, pre_idx != NULL);
+	learn_costs(r, &pp, &pl, results);
 	if (stopped) {
 		progress(r, "pass %d: %d of %zu region renders stopped at the budget's end, "
 			 "their samples lost", pass, stopped, n);
