@@ -1265,6 +1265,75 @@ static void test_plan_make(void **state)
 	free(in);
 }
 
+/* 6b. Packing looks past the last merge that saved: two renders' jobs
+ * saved at once may pay where neither merge alone does; and pixels a
+ * rectangle takes along count at the dearest gain the plan took. */
+static void test_plan_pack_ahead(void **state)
+{
+	/* two tall blocks at the sides, a third between them, two tiles of
+	 * the packing grid apart: any one merge adds more pixels than a job
+	 * is worth, the frame's width less */
+	static const int three[3][4] = { { 0, 0, 7, 39 }, { 56, 0, 63, 39 }, { 24, 16, 39, 25 } };
+	static const int two[2][4] = { { 0, 0, 7, 7 }, { 24, 0, 31, 7 } };
+	struct plan_params p;
+	struct plan_input *in = plan_setup(&p);
+	struct plan pl;
+
+	(void)state;
+	image_release(&in->acc);
+	plan_input(in, three, 3, 0.25f);
+	p.target = 1e-6;
+	/* a job worth 1000 pixels at scale 2: merging a side block and the
+	 * middle one adds 1120 pixels, the two sides 1920; all three in one
+	 * render cost 2560 and a job, against 800 and three jobs */
+	p.cost_job = 1000.0 * 4.0 * p.cost_sample;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	check_regions(&pl, &p);
+	assert_int_equal(pl.nregions, 1);
+	assert_int_equal(pl.pixels, 64 * 40);
+	assert_close(pl.cost, p.cost_job + 2560.0 * 4.0 * p.cost_sample, 1e-9, 0.0, "one render");
+	plan_release(&pl);
+	/* at 700 pixels a job the three alone are cheaper (2900 against 3260) */
+	p.cost_job = 700.0 * 4.0 * p.cost_sample;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	check_regions(&pl, &p);
+	assert_int_equal(pl.nregions, 3);
+	assert_int_equal(pl.pixels, 800);
+	plan_release(&pl);
+	image_release(&in->acc);
+
+	/* two 8 x 8 blocks 16 columns apart, the 128 pixels between them
+	 * with a little error each (0.01 / 0.26), not chosen at this target:
+	 * the merge adds 128 pixels at scale 2 for one job (the target too low
+	 * to meet, but the strip's pixels gain too little to be taken) */
+	plan_input(in, two, 2, 0.25f);
+	for (int y = 0; y <= 7; y++)
+		for (int x = 8; x <= 23; x++) {
+			in->press[y * PW + x] = 0.01f;
+			for (int c = 0; c < 3; c++)
+				accpx(&in->acc, (size_t)y * PW + x)[c] = (float)((x + y) % 2);
+		}
+	p.target = 1e-6;
+	p.min_gain = 0.05 / p.target;	/* a rider gains 0.031: not a candidate */
+	/* the gap costs 512 sample costs: a job of 520 merges whatever the
+	 * riders are worth, one of 500 only for them (each block pixel took
+	 * its 0.77 of gain for 4 sample costs: a rider's 0.031 is worth 0.16
+	 * of them, the strip's 20.5), and one of 480 not even so */
+	const double job[3] = { 520.0, 500.0, 480.0 };
+	const size_t regions[3] = { 1, 1, 2 };
+	for (int k = 0; k < 3; k++) {
+		p.cost_job = job[k] * p.cost_sample;
+		assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+		check_regions(&pl, &p);
+		assert_int_equal(pl.chosen_pixels, 128);
+		assert_int_equal(pl.nregions, regions[k]);
+		assert_int_equal(pl.pixels, regions[k] == 1 ? 256 : 128);
+		plan_release(&pl);
+	}
+	image_release(&in->acc);
+	free(in);
+}
+
 /* The factor value_bias() puts on a pixel's relative error (accum.c): mean
  * over R, G, B of m^2 + 0.01 over that of max(m^2 - var / n, m^2 / 4) + 0.01. */
 /* The cost of a plan's regions as rect_cost() has it. */
@@ -2096,6 +2165,7 @@ int main(void)
 		cmocka_unit_test(test_read_rows),
 		cmocka_unit_test(test_plan_make),
 		cmocka_unit_test(test_plan_budget),
+		cmocka_unit_test(test_plan_pack_ahead),
 		cmocka_unit_test(test_plan_cost_map),
 		cmocka_unit_test(test_pixel_errors),
 		cmocka_unit_test(test_pixel_errors_threads),
