@@ -880,11 +880,13 @@ static void test_merge_aa_edges(void **state)
 
 	/* hidden edges: pixel 0 beside a pixel 0.6 brighter, with 8
 	 * samples and no spread each; as edge pixels the difference that
-	 * counts is at most the threshold / 3 */
+	 * counts is at most the threshold / 3; and where POV-Ray subdivided
+	 * the neighbour (ACC_AA_DEEP) and not pixel 0, the edge is the
+	 * neighbour's: none is charged to pixel 0 */
 	struct image two;
 	make_acc(&two, 2, 1, flat_value);
-	double e[2];
-	for (int k = 0; k < 2; k++) {
+	double e[3];
+	for (int k = 0; k < 3; k++) {
 		for (int x = 0; x < 2; x++) {
 			float *o = accpx(&two, (size_t)x);
 			for (int c = 0; c < 3; c++) {
@@ -893,10 +895,12 @@ static void test_merge_aa_edges(void **state)
 			}
 			o[ACC_SAMPLES] = 8.0f;
 			o[ACC_SCALES] = (float)(1u << 1 | 1u << 2 | 1u << ACC_AA | 1u << ACC_AA_HALF |
-						(k ? 1u << ACC_AA_EDGE : 0u));
+						(k ? 1u << ACC_AA_EDGE : 0u) |
+						(k == 2 && x == 1 ? 1u << ACC_AA_DEEP : 0u));
 		}
 		e[k] = accum_pixel_error(&two, 0, NAN, NULL, 0.0);
 	}
+	assert_true(e[2] == 0.0);
 	double cap = 0.0;	/* hidden_edge()'s sum with |d| at the cap, scale 2 */
 	for (int c = 0; c < 3; c++)
 		for (int k = 0; k < 4; k++) {
