@@ -807,9 +807,9 @@ static int neighbours8(const struct image *acc, size_t i, const float *q[8])
  * render that POV-Ray did not subdivide is charged nothing towards one it
  * did (ACC_AA_DEEP): the edge is there, and with the weight above 8 / 10
  * of it fell on this side (at --target 3e-3 still_life's 403 such pixels
- * held 1.1e-5 of its estimate of 2.55e-5, for a true 4e-7; without it the
- * estimate is 1.66e-5 for a true 4.28e-6, the same image).  The largest
- * over the eight neighbours, mean over R, G, B.
+ * held 1.1e-5 of its estimate of 2.55e-5, for a true 4e-7; with this
+ * exemption the estimate is 1.66e-5 for a true 4.28e-6, the same image).
+ * The largest over the eight neighbours, mean over R, G, B.
  */
 static double hidden_edge(const struct image *acc, size_t i, int s)
 {
@@ -830,7 +830,11 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 		/* ... and where POV-Ray subdivided the neighbour and not this
 		 * pixel, the edge is the neighbour's: the two share the corners
 		 * on their border, and an edge crossing into this pixel's render
-		 * pixels would have parted their corners too */
+		 * pixels would have parted their corners too.  (ACC_AA_DEEP is
+		 * scale 8's bit: a neighbour of the render refined at scale 8
+		 * later counts too, and loses only the capped term for a step
+		 * below the threshold, which its corners' agreement with this
+		 * pixel's bounded already.) */
 		if (seen && accum_has_scale(acc, qi, ACC_AA_DEEP) && !accum_has_scale(acc, i, ACC_AA_DEEP))
 			continue;
 		double e = 0.0;

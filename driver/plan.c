@@ -381,7 +381,8 @@ static int pack(const struct plan_params *p, int w, int h, int s, const unsigned
 	/* greedy merging: the pair whose bounding box saves the most (or, over
 	 * the cap, costs the least extra), its riders' worth taken off its
 	 * cost.  Where no merge saves any more and PACK_AHEAD rectangles or
-	 * fewer are left, merging goes on down to one, and the cheapest of the
+	 * fewer (and no more than the cap) are left, merging goes on down to
+	 * one, and the cheapest of the
 	 * sets it passes is kept: two merges may save what neither does alone
 	 * (soft_shadows at --target 3e-3: five rectangles, or two covering 3,149
 	 * pixels more for the same CPU and a quarter less error, as the cost
@@ -413,7 +414,8 @@ static int pack(const struct plan_params *p, int w, int h, int s, const unsigned
 			for (size_t k = 0; k < n; k++)
 				keep_net += rect_net(p, rd, &r[k], px);
 		}
-		if (n < 2 || (!ahead && best > 0.0 && n <= (size_t)cap))
+		/* (no finite cost: nothing to merge by) */
+		if (n < 2 || !(best < INFINITY) || (!ahead && best > 0.0 && n <= (size_t)cap))
 			break;
 		struct plan_region m;
 		bbox(&r[ba], &r[bb], &m);
@@ -777,9 +779,11 @@ static void riders_table(const struct image *acc, const double *e, const unsigne
 		sat[(size_t)(y + 1) * sw] = 0.0;
 		for (int x = 0; x < w; x++) {
 			size_t i = (size_t)y * w + x;
-			if (!ps[i] && !accum_has_scale(acc, i, s) && isfinite(e[i])) {
+			if (!ps[i] && !accum_has_scale(acc, i, s)) {
 				double n = acc->px[i * ACC_NCH + ACC_SAMPLES];
-				row += e[i] * m / (n + m);
+				double g = e[i] * m / (n + m);
+				if (isfinite(g) && g > 0.0)
+					row += g;
 			}
 			sat[(size_t)(y + 1) * sw + x + 1] = sat[(size_t)y * sw + x + 1] + row;
 		}
@@ -914,8 +918,7 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	ps = calloc(npx, 1);
 	out->scale = calloc(npx, sizeof(float));
 	out->chosen = calloc(npx, sizeof(float));
-	riders = malloc(((size_t)w + 1) * ((size_t)h + 1) * sizeof(*riders));
-	if (!gain || !cand || !mark || !ps || !out->scale || !out->chosen || !riders) {
+	if (!gain || !cand || !mark || !ps || !out->scale || !out->chosen) {
 		errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
 		goto out;
 	}
@@ -994,6 +997,12 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 				     : p->budget;
 	double upto = p->fill < cap ? p->fill : cap, lo = spend0, hi = INFINITY;
 	const int upgrading = total0 > goal && spend0 < upto;
+	/* the riders' table (pack_all()), without a budget only */
+	if (!(p->budget > 0.0) &&
+	    !(riders = malloc(((size_t)w + 1) * ((size_t)h + 1) * sizeof(*riders)))) {
+		errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
+		goto out;
+	}
 	if (upgrading && !(heap = malloc(taken * sizeof(*heap)))) {
 		errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
 		goto out;
@@ -1020,11 +1029,12 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 			if (next_upgrade(p, acc, u.i, e[u.i], u.to, smax, &u))
 				heap_push(heap, &nh, u);
 		}
-		/* riders count without a budget: under one, what they would
-		 * cost beyond it is cut again by value (fit_budget()), and at
-		 * the dearest gain taken they are worth what they cost */
-		if (pack_all(p, acc, e, cand, taken, ps, gain, p->budget > 0.0 ? 0.0 : lambda,
-			     riders, mark, out)) {
+		/* riders count without a budget (riders is NULL under one):
+		 * what they would cost beyond it is cut again by value
+		 * (fit_budget()), and at the dearest gain taken they are worth
+		 * at most what they cost (a pixel not taken gains less for its
+		 * cost than any taken) */
+		if (pack_all(p, acc, e, cand, taken, ps, gain, lambda, riders, mark, out)) {
 			errbuf_printf(err, errlen, "out of memory packing regions");
 			goto out;
 		}
