@@ -120,7 +120,9 @@ static const char usage_options2[] =
 	"                        +AM2 +A0.1 +R4 +J (+R3 where a budget would not\n"
 	"                        fit it); where it is spread and the frame at\n"
 	"                        scale 4 takes less than 0.7 s on\n"
-	"                        the cores, as jitter), grid\n"
+	"                        the cores, as jitter; scale throughout where the\n"
+	"                        file sets assumed_gamma other than 1, in whose\n"
+	"                        encoding POV-Ray's antialiasing averages), grid\n"
 	"                        (scales 4, 8 and 16 as renders at twice the size with\n"
 	"                        POV-Ray's +AM1 +A0.0 +R(scale/2) +J0.75: scale x\n"
 	"                        scale jittered samples), scale (resolution scaling\n"
@@ -231,6 +233,10 @@ struct run {
 	int focal;		/* --sampler auto and the scene has focal blur
 				 * (scene_focal_blur()): resolution scaling up to
 				 * PLAN_FOCAL_FRAME, no jitter */
+	double gamma;		/* the scene's assumed_gamma where it is not 1
+				 * (scene_assumed_gamma()), else 0: under
+				 * --sampler auto resolution scaling only, no
+				 * antialiased render (run_grid()) */
 	struct pass_rec *passes;
 	size_t npasses;
 	const char *stop;
@@ -672,6 +678,8 @@ static void json_str(FILE *f, const char *s)
  * auto (a resumed run may give another). */
 static int run_grid(const struct run *r)
 {
+	if (r->gamma > 0.0 && r->grid == PLAN_GRID_LARGE)
+		return PLAN_GRID_NEVER;
 	return r->jittered && r->grid == PLAN_GRID_LARGE ? PLAN_GRID_ONLY : r->grid;
 }
 
@@ -704,12 +712,14 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 	json_str(f, r->stop ? r->stop : "");
 	fprintf(f, ",\n  \"cost_model\": {\"job_s\": %.17g, \"sample_s\": %.17g, "
 		"\"latency_s\": %.6g, \"scale\": %.4g, \"learnt\": %d},\n  \"radiosity\": %s,\n"
-		"  \"radiosity_scale\": %d,\n  \"focal_blur\": %s,\n  \"povwait\": %s,\n"
+		"  \"radiosity_scale\": %d,\n  \"focal_blur\": %s,\n  \"assumed_gamma\": %g,\n"
+		"  \"povwait\": %s,\n"
 		"  \"sampler\": \"%s\",\n  \"sampler_chosen\": \"%s\",\n  \"prelaunch\": \"%s\",\n"
 		"  \"final\": \"%s\",\n  \"passes\": [\n",
 		r->cost_job, r->cost_sample, r->latency, cost_map_mean(r), r->cost_learnt,
 		r->radiosity ? "true" : "false",
-		r->rad_scale, r->focal ? "true" : "false", pov_wait_library() ? "true" : "false",
+		r->rad_scale, r->focal ? "true" : "false", r->gamma > 0.0 ? r->gamma : 1.0,
+		pov_wait_library() ? "true" : "false",
 		r->aa ? "aa" : plan_grid_name(r->grid),
 		r->aa ? "aa" : plan_grid_name(run_grid(r)),
 		prelaunch_names[r->prelaunch],
@@ -1149,12 +1159,10 @@ static int word_at(const char *t, size_t i, const char *w)
  * scaling at 8 (64) 7.8e-5 and at 16 (256) 2.3e-5; on the other bundled
  * scenes the grid renders did as well as scaling or better (README).
  */
-static int scene_focal_blur(const char *path)
+/* Calls visit(t, i, ctx) at each index i of the scene text t outside
+ * comments and strings. */
+static void scan_code(const char *t, void (*visit)(const char *t, size_t i, void *ctx), void *ctx)
 {
-	char *t = file_read_text(path);
-	if (!t)
-		return 0;
-	int ap = 0, bs = 0;
 	for (size_t i = 0; t[i]; i++) {
 		if (t[i] == '/' && t[i + 1] == '/') {
 			while (t[i + 1] && t[i + 1] != '\n')
@@ -1171,17 +1179,82 @@ static int scene_focal_blur(const char *path)
 				i++;
 			if (t[i + 1])
 				i++;
-		} else if (word_at(t, i, "aperture")) {
-			/* "aperture 0" is a camera without focal blur */
-			const char *v = t + i + sizeof "aperture" - 1;
-			char *end;
-			ap |= strtod(v, &end) != 0.0 || end == v;
 		} else {
-			bs |= word_at(t, i, "blur_samples");
+			visit(t, i, ctx);
 		}
 	}
+}
+
+/* The number after the keyword at t[i] (sizeof key - 1 long), or NAN. */
+static double number_after(const char *t, size_t i, size_t keylen)
+{
+	const char *v = t + i + keylen;
+	char *end;
+	double x = strtod(v, &end);
+	return end == v ? NAN : x;
+}
+
+struct focal_scan {
+	int ap, bs;
+};
+
+static void focal_visit(const char *t, size_t i, void *ctx)
+{
+	struct focal_scan *f = ctx;
+	if (word_at(t, i, "aperture")) {
+		/* "aperture 0" is a camera without focal blur */
+		double x = number_after(t, i, sizeof "aperture" - 1);
+		f->ap |= !(x == 0.0);
+	} else {
+		f->bs |= word_at(t, i, "blur_samples");
+	}
+}
+
+static int scene_focal_blur(const char *path)
+{
+	char *t = file_read_text(path);
+	if (!t)
+		return 0;
+	struct focal_scan f = { 0, 0 };
+	scan_code(t, focal_visit, &f);
 	free(t);
-	return ap && bs;
+	return f.ap && f.bs;
+}
+
+/*
+ * The value the scene file (not what it includes) gives assumed_gamma,
+ * outside comments and strings, when it is a number other than 1 (the
+ * last such); 0 where it gives none, gives 1, or gives an expression.
+ * There POV-Ray's antialiasing averages its samples in that gamma's
+ * encoding, not linearly as resolution scaling's box average does: grid
+ * renders and antialiased renders are biased against the linear
+ * reference.  Debian's advanced/biscuit (assumed_gamma 1.3) at 160x120,
+ * the whole frame against resolution scaling at 15: +AM1 +A0.0 +R4 +J0
+ * (scale 4's positions and the centre) 3.8e-3, scaling at 4 1.33e-3, the
+ * grid render at scale 4 (+AM1 +A0.0 +R2 +J0.75 at twice the size)
+ * 2.36e-3.  povpress render there, --sampler auto against scale: --target
+ * 1e-3 7.2e-4 in 8.8 CPU s against 1.7e-4 in 9.2 s; advanced/pawns (1.8)
+ * 1.33e-3 in 7.5 s against 4.5e-4 in 8.5 s; lights/spotlite (2.2) at
+ * --budget 3 5.3e-4 against 5.7e-5.
+ */
+static void gamma_visit(const char *t, size_t i, void *ctx)
+{
+	if (word_at(t, i, "assumed_gamma")) {
+		double x = number_after(t, i, sizeof "assumed_gamma" - 1);
+		if (isfinite(x))
+			*(double *)ctx = x;
+	}
+}
+
+static double scene_assumed_gamma(const char *path)
+{
+	char *t = file_read_text(path);
+	if (!t)
+		return 0.0;
+	double g = 1.0;
+	scan_code(t, gamma_visit, &g);
+	free(t);
+	return fabs(g - 1.0) > 0.01 && g > 0.0 ? g : 0.0;
 }
 
 /*
@@ -1239,9 +1312,9 @@ static void prelaunch_first(struct run *r)
 	int nk = 0;
 	if (r->grid != PLAN_GRID_ONLY)
 		kinds[nk++] = (struct pre_kind){ 2, 0, 0, 0 };
-	if (r->grid != PLAN_GRID_NEVER && !r->focal)	/* one_step()'s jitter */
+	if (run_grid(r) != PLAN_GRID_NEVER && !r->focal)	/* one_step()'s jitter */
 		kinds[nk++] = (struct pre_kind){ 4, ACC_GRID_FRAME, 0, 0 };
-	if (r->grid == PLAN_GRID_LARGE && !r->aa)
+	if (run_grid(r) == PLAN_GRID_LARGE && !r->aa)
 		kinds[nk++] = (struct pre_kind){ ACC_AA, ACC_GRID_FRAME, ACC_AA_DEPTH, 0 };
 	prelaunch_start(r, 1, kinds, nk, r->cores);
 }
@@ -1350,6 +1423,10 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	struct pov_result res = {0};
 	double t = now_s(), c = self_cpu();
 	progress(r, "base pass: %dx%d, 1 sample per pixel", r->w, r->h);
+	if (r->gamma > 0.0 && r->grid == PLAN_GRID_LARGE && r->verbose)
+		fprintf(stderr, "povpress render: the scene's assumed_gamma is %g, in whose encoding "
+				"POV-Ray's antialiasing averages: resolution scaling only\n",
+			r->gamma);
 	prelaunch_first(r);
 	/* one sample at each pixel centre; radiosity, if the scene has any, is
 	 * saved for the region renders */
@@ -1514,7 +1591,7 @@ static int sparse_error(const struct run *r, int *memo)
  */
 static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
 {
-	const int first = r->grid == PLAN_GRID_LARGE && has_scale2(pl) &&
+	const int first = run_grid(r) == PLAN_GRID_LARGE && has_scale2(pl) &&
 			  sparse_error(r, sparse);
 	if (!first && !r->aa)
 		return 0;
@@ -1650,7 +1727,7 @@ static void aa_depth(const struct run *r, struct plan *pl, const struct plan_par
 static int one_step(const struct run *r, int *sparse)
 {
 	const double frame4 = 16.0 * r->cost_sample * (double)r->w * r->h;
-	return r->grid == PLAN_GRID_LARGE && r->npasses == 1 && !r->radiosity && !r->focal &&
+	return run_grid(r) == PLAN_GRID_LARGE && r->npasses == 1 && !r->radiosity && !r->focal &&
 	       frame4 < JITTER_FRAME_S * r->cores && !sparse_error(r, sparse);
 }
 
@@ -1835,6 +1912,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			pp.grid_frame = PLAN_FOCAL_FRAME;
 			pp.cost_frame = FRAME_COST;
 		}
+		if (r->gamma > 0.0 && r->grid == PLAN_GRID_LARGE)	/* scaled frames at every scale */
+			pp.cost_frame = FRAME_COST;
 		pp.min_split = r->budget > 0.0 ? 2 * r->cores : r->cores;
 		/* under a budget, a pass that leaves the target unmet and
 		 * would take less than 1% of the error off is not worth
@@ -2249,6 +2328,7 @@ bad:
 		goto fail_early;
 	}
 	r.focal = r.grid == PLAN_GRID_LARGE && !r.aa && scene_focal_blur(r.scene);
+	r.gamma = scene_assumed_gamma(r.scene);
 	{
 		struct pov_job probe = { .scene = r.scene };
 		char bin[PATH_MAX];

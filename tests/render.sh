@@ -326,6 +326,40 @@ check "focal blur: scenes/focal_blur.pov has it" grep -q '"focal_blur": true' "$
 	--report "$T/fb-grid.json" -- +WT1 || bad "focal blur, --sampler grid: render failed"
 check "focal blur: only --sampler auto looks for it" grep -q '"focal_blur": false' "$T/fb-grid.json"
 
+# --- --sampler auto with assumed_gamma other than 1: resolution scaling only --
+# POV-Ray's antialiasing averages its samples in the scene's gamma encoding,
+# resolution scaling's box average linearly: under auto such a scene gets no
+# grid render and no antialiased render.  A checkerboard whose squares are
+# finer than the pixels has error everywhere (at 320x240 auto would render
+# scale 4 as a grid render, 640x480, and may take the jittered first step).
+cat >"$T/gamma.pov" <<'EOF'
+#version 3.7;
+global_settings { assumed_gamma 1.8 }
+camera { location <0, 1, -3> look_at <0, 0.5, 0> }
+light_source { <2, 4, -3> rgb 1 }
+plane { y, 0 pigment { checker rgb 0.05 rgb 0.95 scale 0.02 } }
+sphere { <0, 0.5, 0>, 0.5 pigment { rgb <1, 0.3, 0.2> } finish { specular 0.8 roughness 0.002 } }
+EOF
+sed 's|assumed_gamma 1.8|assumed_gamma 1.0 // assumed_gamma 1.8\n#debug "assumed_gamma 2.2"|' \
+	"$T/gamma.pov" >"$T/gamma1.pov"
+"$PP" render "$T/gamma.pov" -o "$T/gamma.exr" -W 320 -H 240 --target 1e-3 --max-passes 2 -v \
+	--keep-workdir --report "$T/gamma.json" -- +WT1 2>"$T/gamma.log" || bad "gamma: render failed"
+check "gamma: the report gives the scene's assumed_gamma" grep -q '"assumed_gamma": 1.8,' "$T/gamma.json"
+check "gamma: auto chooses resolution scaling" grep -q '"sampler_chosen": "scale"' "$T/gamma.json"
+check "gamma: -v says so" grep -q "assumed_gamma is 1.8" "$T/gamma.log"
+g4=$(compgen -G "$T/gamma.exr.work/p0[12]-*-s4.exr" | head -n 1)
+check "gamma: a scale-4 render, by resolution scaling (1280x960)" \
+	grep -q "1280 x *960" <(iinfo "$g4" 2>&1)
+check "gamma: no antialiased render" \
+	test -z "$(compgen -G "$T/gamma.exr.work/p0*-aa.exr")"
+"$PP" render "$T/gamma1.pov" -o "$T/gamma1.exr" -W 40 -H 30 --max-passes 0 -q \
+	--report "$T/gamma1.json" -- +WT1 || bad "gamma 1: render failed"
+check "gamma: 1, or a value in comments and strings, is not another gamma" \
+	grep -q '"assumed_gamma": 1,' "$T/gamma1.json"
+"$PP" render "$T/gamma.pov" -o "$T/gamma-grid.exr" -W 40 -H 30 --max-passes 0 -q --sampler grid \
+	--report "$T/gamma-grid.json" -- +WT1 || bad "gamma, --sampler grid: render failed"
+check "gamma: --sampler grid is kept" grep -q '"sampler_chosen": "grid"' "$T/gamma-grid.json"
+
 # --- --sampler auto where the error sits in a few pixels: antialiasing first -
 # hdr_highlights' lamps and their reflections hold half the base pass's
 # estimated error in 0.1% of the pixels at 160x120 (at 80x60, 0.1% is 4
