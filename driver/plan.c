@@ -204,16 +204,41 @@ double plan_region_map(const struct plan_params *p, const struct plan_region *r,
 	return m;
 }
 
+/* The sum over pixels x0..x1 x y0..y1 (inclusive) of an image w pixels
+ * wide from its summed-area table t, (w + 1) x (h + 1) (sat_fill()). */
+static double sat_sum(const double *t, int w, int x0, int y0, int x1, int y1)
+{
+	const size_t sw = (size_t)w + 1;
+	return t[(size_t)(y1 + 1) * sw + x1 + 1] - t[(size_t)y0 * sw + x1 + 1] -
+	       t[(size_t)(y1 + 1) * sw + x0] + t[(size_t)y0 * sw + x0];
+}
+
+/* Make t, (w + 1) x (h + 1), a summed-area table in place: it holds pixel
+ * (x, y)'s value at t[(y + 1) (w + 1) + x + 1]; its first row and column are
+ * set to 0. */
+static void sat_fill(double *t, int w, int h)
+{
+	const size_t sw = (size_t)w + 1;
+	for (int x = 0; x <= w; x++)
+		t[x] = 0.0;
+	for (int y = 0; y < h; y++) {
+		double row = 0.0;
+		t[(size_t)(y + 1) * sw] = 0.0;
+		for (int x = 0; x < w; x++) {
+			double *c = &t[(size_t)(y + 1) * sw + x + 1];
+			row += *c;
+			*c = t[(size_t)y * sw + x + 1] + row;
+		}
+	}
+}
+
 /* The cost map's sum over pixels x0..x1 x y0..y1 (inclusive) from its
  * summed-area table: their area without a map. */
 static double map_sum(const struct plan_params *p, int x0, int y0, int x1, int y1)
 {
 	if (!p->cost_sat)
 		return (double)(x1 - x0 + 1) * (y1 - y0 + 1);
-	const size_t sw = (size_t)p->cost_sat_w + 1;
-	const double *t = p->cost_sat;
-	return t[(size_t)(y1 + 1) * sw + x1 + 1] - t[(size_t)y0 * sw + x1 + 1] -
-	       t[(size_t)(y1 + 1) * sw + x0] + t[(size_t)y0 * sw + x0];
+	return sat_sum(p->cost_sat, p->cost_sat_w, x0, y0, x1, y1);
 }
 
 /* Pixel i's cost a sample over cost_sample. */
@@ -264,9 +289,9 @@ static int tile_occupied(const unsigned char *mark, int w, int h, int tile, int 
 
 /*
  * What a rectangle's pixels that were not chosen gain from it (riders):
- * rd the summed-area table, (w + 1) x (h + 1), of each such pixel's gain at
- * the scale packed, worth lambda seconds a unit of gain (the dearest gain
- * the plan took).  NULL rd: riders are worth nothing.
+ * sat the summed-area table of each such pixel's gain at the scale packed,
+ * worth lambda seconds a unit of gain (the dearest gain the plan took).
+ * No riders (NULL): they are worth nothing.
  */
 struct riders {
 	const double *sat;
@@ -274,21 +299,22 @@ struct riders {
 	double lambda;
 };
 
-static double riders_worth(const struct riders *rd, const struct plan_region *r)
-{
-	if (!rd || !rd->sat)
-		return 0.0;
-	const size_t sw = (size_t)rd->w + 1;
-	const double *t = rd->sat;
-	return rd->lambda * (t[(size_t)(r->y1 + 1) * sw + r->x1 + 1] - t[(size_t)r->y0 * sw + r->x1 + 1] -
-			     t[(size_t)(r->y1 + 1) * sw + r->x0] + t[(size_t)r->y0 * sw + r->x0]);
-}
-
 /* A rectangle's cost less what its riders are worth. */
 static double rect_net(const struct plan_params *p, const struct riders *rd,
 		       const struct plan_region *r, double px)
 {
-	return rect_cost(p, r, px) - riders_worth(rd, r);
+	double c = rect_cost(p, r, px);
+	return rd ? c - rd->lambda * sat_sum(rd->sat, rd->w, r->x0, r->y0, r->x1, r->y1) : c;
+}
+
+/* The net cost of the n rectangles r (rect_net()) together. */
+static double set_net(const struct plan_params *p, const struct riders *rd,
+		      const struct plan_region *r, size_t n, double px)
+{
+	double net = 0.0;
+	for (size_t k = 0; k < n; k++)
+		net += rect_net(p, rd, &r[k], px);
+	return net;
 }
 
 /*
@@ -382,8 +408,8 @@ static int pack(const struct plan_params *p, int w, int h, int s, const unsigned
 	 * the cap, costs the least extra), its riders' worth taken off its
 	 * cost.  Where no merge saves any more and PACK_AHEAD rectangles or
 	 * fewer (and no more than the cap) are left, merging goes on down to
-	 * one, and the cheapest of the
-	 * sets it passes is kept: two merges may save what neither does alone
+	 * one, and the cheapest of the sets it passes is kept: two merges may
+	 * save what neither does alone
 	 * (soft_shadows at --target 3e-3: five rectangles, or two covering 3,149
 	 * pixels more for the same CPU and a quarter less error, as the cost
 	 * of a POV-Ray run was measured 2^-6 or 2^-5 s) */
@@ -410,9 +436,7 @@ static int pack(const struct plan_params *p, int w, int h, int s, const unsigned
 			ahead = 1;
 			nkeep = n;
 			memcpy(keep, r, n * sizeof(*r));
-			keep_net = 0.0;
-			for (size_t k = 0; k < n; k++)
-				keep_net += rect_net(p, rd, &r[k], px);
+			keep_net = set_net(p, rd, r, n, px);
 		}
 		/* (no finite cost: nothing to merge by) */
 		if (n < 2 || !(best < INFINITY) || (!ahead && best > 0.0 && n <= (size_t)cap))
@@ -433,9 +457,7 @@ static int pack(const struct plan_params *p, int w, int h, int s, const unsigned
 			k--;
 		}
 		if (ahead) {
-			double net = 0.0;
-			for (size_t k = 0; k < n; k++)
-				net += rect_net(p, rd, &r[k], px);
+			const double net = set_net(p, rd, r, n, px);
 			/* cheaper by more than rounding */
 			if (net < keep_net - 1e-9 * fabs(keep_net)) {
 				keep_net = net;
@@ -773,21 +795,15 @@ static void riders_table(const struct image *acc, const double *e, const unsigne
 	const int w = acc->w, h = acc->h;
 	const size_t sw = (size_t)w + 1;
 	const double m = (double)s * s;
-	memset(sat, 0, sw * sizeof(*sat));
-	for (int y = 0; y < h; y++) {
-		double row = 0.0;
-		sat[(size_t)(y + 1) * sw] = 0.0;
+	for (int y = 0; y < h; y++)
 		for (int x = 0; x < w; x++) {
-			size_t i = (size_t)y * w + x;
-			if (!ps[i] && !accum_has_scale(acc, i, s)) {
-				double n = acc->px[i * ACC_NCH + ACC_SAMPLES];
-				double g = e[i] * m / (n + m);
-				if (isfinite(g) && g > 0.0)
-					row += g;
-			}
-			sat[(size_t)(y + 1) * sw + x + 1] = sat[(size_t)y * sw + x + 1] + row;
+			const size_t i = (size_t)y * w + x;
+			double g = 0.0;
+			if (!ps[i] && !accum_has_scale(acc, i, s))
+				g = e[i] * m / (acc->px[i * ACC_NCH + ACC_SAMPLES] + m);
+			sat[(size_t)(y + 1) * sw + x + 1] = isfinite(g) && g > 0.0 ? g : 0.0;
 		}
-	}
+	sat_fill(sat, w, h);
 }
 
 /* Pack the chosen pixels (the first taken of cand) per scale, ps their
@@ -809,12 +825,13 @@ static int pack_all(const struct plan_params *p, const struct image *acc, const 
 				any = mark[cand[t].i] = 1;
 		if (!any)
 			continue;
-		struct riders rd = { sat, w, lambda };
-		if (sat && lambda > 0.0)
+		const struct riders rd = { sat, w, lambda };
+		const struct riders *rdp = sat && lambda > 0.0 ? &rd : NULL;
+		if (rdp)
 			riders_table(acc, e, ps, s, sat);
 		int rc, tile = p->tile;
-		while ((rc = pack(p, w, h, s, mark, gain, sat && lambda > 0.0 ? &rd : NULL, tile,
-				  p->max_regions, &out->regions, &out->nregions)) == 1)
+		while ((rc = pack(p, w, h, s, mark, gain, rdp, tile, p->max_regions, &out->regions,
+				  &out->nregions)) == 1)
 			tile *= 2;
 		if (rc)
 			return -1;
@@ -868,16 +885,13 @@ int plan_make(const struct image *acc, const float *press, const float *fit,
 static double *map_table(const float *map, int w, int h)
 {
 	const size_t sw = (size_t)w + 1;
-	double *t = calloc(sw * ((size_t)h + 1), sizeof(*t));
+	double *t = malloc(sw * ((size_t)h + 1) * sizeof(*t));
 	if (!t)
 		return NULL;
-	for (int y = 0; y < h; y++) {
-		double row = 0.0;
-		for (int x = 0; x < w; x++) {
-			row += map[(size_t)y * w + x];
-			t[(size_t)(y + 1) * sw + x + 1] = t[(size_t)y * sw + x + 1] + row;
-		}
-	}
+	for (int y = 0; y < h; y++)
+		for (int x = 0; x < w; x++)
+			t[(size_t)(y + 1) * sw + x + 1] = map[(size_t)y * w + x];
+	sat_fill(t, w, h);
 	return t;
 }
 

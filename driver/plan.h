@@ -78,7 +78,6 @@ struct plan_params {
  * invocation and, with cost_frame, its frame. */
 double plan_job_cost(const struct plan_params *p, int s, double px);
 
-
 /* Grid renders: never (resolution scaling), for every scale of 4 or more,
  * or for those whose scaled frame would exceed grid_frame pixels
  * (PLAN_GRID_FRAME, or PLAN_FOCAL_FRAME where render's --sampler auto finds

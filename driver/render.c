@@ -673,12 +673,20 @@ static void json_str(FILE *f, const char *s)
 	fputc('"', f);
 }
 
-/* The PLAN_GRID_* mode the run goes by: --sampler's, or PLAN_GRID_ONLY where
- * auto chose jitter (one_step()); the stored choice holds while --sampler is
- * auto (a resumed run may give another). */
+/* Whether --sampler auto goes by resolution scaling alone for the scene's
+ * assumed_gamma (scene_assumed_gamma()). */
+static int gamma_scaling(const struct run *r)
+{
+	return r->gamma > 0.0 && r->grid == PLAN_GRID_LARGE;
+}
+
+/* The PLAN_GRID_* mode the run goes by: --sampler's, PLAN_GRID_NEVER where
+ * auto meets a scene's assumed_gamma (gamma_scaling()), or PLAN_GRID_ONLY
+ * where it chose jitter (one_step()); the stored choice holds while
+ * --sampler is auto (a resumed run may give another). */
 static int run_grid(const struct run *r)
 {
-	if (r->gamma > 0.0 && r->grid == PLAN_GRID_LARGE)
+	if (gamma_scaling(r))
 		return PLAN_GRID_NEVER;
 	return r->jittered && r->grid == PLAN_GRID_LARGE ? PLAN_GRID_ONLY : r->grid;
 }
@@ -1146,19 +1154,6 @@ static int word_at(const char *t, size_t i, const char *w)
 	return !before && !after;
 }
 
-/*
- * Whether the scene file (not what it includes) names both of focal blur's
- * camera keywords, aperture (but for "aperture 0") and blur_samples,
- * outside comments and strings.  There
- * POV-Ray's antialiasing converges far more slowly than resolution scaling:
- * each antialiasing sub-sample traces its own blur samples, whose sub-pixel
- * offsets come from a table indexed by the position (tracepixel.cpp), so
- * the sub-samples of a pixel share much of their pattern.  focal_blur at
- * 160x120, the whole frame against the sweep's reference: +AM1 +A0.0 +R8
- * +J0.75 at twice the size (256 samples a pixel) 7.8e-5, resolution
- * scaling at 8 (64) 7.8e-5 and at 16 (256) 2.3e-5; on the other bundled
- * scenes the grid renders did as well as scaling or better (README).
- */
 /* Calls visit(t, i, ctx) at each index i of the scene text t outside
  * comments and strings. */
 static void scan_code(const char *t, void (*visit)(const char *t, size_t i, void *ctx), void *ctx)
@@ -1210,6 +1205,19 @@ static void focal_visit(const char *t, size_t i, void *ctx)
 	}
 }
 
+/*
+ * Whether the scene file (not what it includes) names both of focal blur's
+ * camera keywords, aperture (but for "aperture 0") and blur_samples,
+ * outside comments and strings.  There
+ * POV-Ray's antialiasing converges far more slowly than resolution scaling:
+ * each antialiasing sub-sample traces its own blur samples, whose sub-pixel
+ * offsets come from a table indexed by the position (tracepixel.cpp), so
+ * the sub-samples of a pixel share much of their pattern.  focal_blur at
+ * 160x120, the whole frame against the sweep's reference: +AM1 +A0.0 +R8
+ * +J0.75 at twice the size (256 samples a pixel) 7.8e-5, resolution
+ * scaling at 8 (64) 7.8e-5 and at 16 (256) 2.3e-5; on the other bundled
+ * scenes the grid renders did as well as scaling or better (README).
+ */
 static int scene_focal_blur(const char *path)
 {
 	char *t = file_read_text(path);
@@ -1423,7 +1431,7 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	struct pov_result res = {0};
 	double t = now_s(), c = self_cpu();
 	progress(r, "base pass: %dx%d, 1 sample per pixel", r->w, r->h);
-	if (r->gamma > 0.0 && r->grid == PLAN_GRID_LARGE && r->verbose)
+	if (gamma_scaling(r) && r->verbose)
 		fprintf(stderr, "povpress render: the scene's assumed_gamma is %g, in whose encoding "
 				"POV-Ray's antialiasing averages: resolution scaling only\n",
 			r->gamma);
@@ -1912,7 +1920,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			pp.grid_frame = PLAN_FOCAL_FRAME;
 			pp.cost_frame = FRAME_COST;
 		}
-		if (r->gamma > 0.0 && r->grid == PLAN_GRID_LARGE)	/* scaled frames at every scale */
+		if (gamma_scaling(r))	/* scaled frames at every scale */
 			pp.cost_frame = FRAME_COST;
 		pp.min_split = r->budget > 0.0 ? 2 * r->cores : r->cores;
 		/* under a budget, a pass that leaves the target unmet and

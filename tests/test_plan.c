@@ -1120,16 +1120,23 @@ static void plan_two_parts(struct plan_input *in, struct plan_params *p, struct 
 /* A block of 6 x 5 pixels with error, for the planner's tests. */
 static const int block[1][4] = { { 20, 17, 25, 21 } };
 
-/* A planner test's input (the block, error 0.25; free() it) and default
- * parameters. */
-static struct plan_input *plan_setup(struct plan_params *p)
+/* A planner test's input (the listed blocks with error err, as
+ * plan_input(); free() it) and default parameters. */
+static struct plan_input *plan_setup_with(struct plan_params *p, const int (*blocks)[4],
+					  int nblocks, float err)
 {
 	struct plan_input *in = malloc(sizeof(*in));
 
 	assert_non_null(in);
 	plan_params_init(p);
-	plan_input(in, block, 1, 0.25f);
+	plan_input(in, blocks, nblocks, err);
 	return in;
+}
+
+/* The same with the block, error 0.25. */
+static struct plan_input *plan_setup(struct plan_params *p)
+{
+	return plan_setup_with(p, block, 1, 0.25f);
 }
 
 /* 6. plan_make: refine, target met, no budget, packing, too little gain,
@@ -1280,12 +1287,10 @@ static void test_plan_pack_ahead(void **state)
 	static const int three[3][4] = { { 0, 0, 7, 39 }, { 56, 0, 63, 39 }, { 24, 16, 39, 25 } };
 	static const int two[2][4] = { { 0, 0, 7, 7 }, { 24, 0, 31, 7 } };
 	struct plan_params p;
-	struct plan_input *in = plan_setup(&p);
+	struct plan_input *in = plan_setup_with(&p, three, 3, 0.25f);
 	struct plan pl;
 
 	(void)state;
-	image_release(&in->acc);
-	plan_input(in, three, 3, 0.25f);
 	p.target = 1e-6;
 	/* a job worth 1000 pixels at scale 2: merging a side block and the
 	 * middle one adds 1120 pixels, the two sides 1920; all three in one
@@ -1453,12 +1458,10 @@ static void test_plan_cost_map(void **state)
 	static const int all[1][4] = { { 0, 0, PW - 1, PH - 1 } };
 	static float map[PW * PH];
 	struct plan_params p;
-	struct plan_input *in = plan_setup(&p);
+	struct plan_input *in = plan_setup_with(&p, all, 1, 0.05f);
 	struct plan pl;
 
 	(void)state;
-	image_release(&in->acc);
-	plan_input(in, all, 1, 0.05f);
 	/* the right half nine times as dear a sample */
 	for (int y = 0; y < PH; y++)
 		for (int x = 0; x < PW; x++)
