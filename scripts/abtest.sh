@@ -16,10 +16,10 @@
 # settings, separated by ';' (default "--budget 2;--budget 4;--budget 8"); a
 # budget setting also gets --target 1e-6, as in make sweep.  --runs N
 # (default 2) runs of each build per setting.  The reference of scene NAME
-# is the newest ${POVPRESS_CACHE:-$HOME/.cache/povpress}/ref/NAME-WxH-sS-*.exr
-# at the size (default 160x120) and scale S (--ref-scale, default 25): make
-# sweep's references (scripts/sweep.sh --quick SCENE.pov makes them at 15, 9
-# and 5 for any scene).
+# is the newest ${POVPRESS_CACHE:-$HOME/.cache/povpress}/ref/NAME-WxH-jS-*.exr
+# at the size (default 160x120) and scale S (--ref-scale, default 15): make
+# sweep's references (scripts/sweep.sh --quick SCENE.pov makes them at 9, 5
+# and 3 for any scene).
 #
 # Prints a line per run and, per scene and setting, the geometric means of
 # both builds' relMSE and CPU and their ratio B/A; at the end the geometric
@@ -35,7 +35,7 @@ ROOT=$(cd "$(dirname "$0")/.." && pwd)
 CACHE=${POVPRESS_CACHE:-$HOME/.cache/povpress}/ref
 runs=2
 size=160x120
-rscale=25
+rscale=15
 args=()
 while (($#)); do
 	case $1 in
@@ -93,7 +93,7 @@ for sc in "${scenes[@]}"; do
 	fi
 	[[ -f $path && -r $path ]] || { echo "abtest: cannot read scene '$path'" >&2; exit 1; }
 	# the newest reference at the size (an edited scene gets a new one)
-	ref=$(ls -t "$CACHE/$sc-${W}x$H-s$rscale-"*.exr 2>/dev/null | head -n 1 || true)
+	ref=$(ls -t "$CACHE/$sc-${W}x$H-j$rscale-"*.exr 2>/dev/null | head -n 1 || true)
 	[[ -n $ref ]] || { echo "abtest: no scale-$rscale reference for $sc at ${W}x$H in $CACHE (make sweep)" >&2; exit 1; }
 	refs[$sc]=$ref
 	paths[$sc]=$path

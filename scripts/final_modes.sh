@@ -15,7 +15,7 @@ trap 'rm -rf "$T"' EXIT
 printf '%-18s %-14s %s\n' scene mode relMSE
 for name in soft_shadows focal_blur glossy_reflection horizon_texture media thin_geometry \
 	hdr_highlights; do
-	ref=$(ls "$CACHE/$name-160x120-s25-"*.exr 2>/dev/null | head -n 1)
+	ref=$(ls "$CACHE/$name-160x120-j15-"*.exr 2>/dev/null | head -n 1)
 	[[ -n $ref ]] || { echo "final_modes: no reference for $name (run make sweep)" >&2; exit 1; }
 	for mode in samples blend auto reconstruction; do
 		"$PP" render "$ROOT/scenes/$name.pov" -o "$T/o.exr" -W 160 -H 120 --target 1e-3 \

@@ -45,7 +45,7 @@ region_relmse() {
 echo "scene,method,setting,cpu_s,relmse" >"$OUT/sampler.csv"
 for name in "${scenes[@]}"; do
 	scene="$ROOT/scenes/$name.pov"
-	ref=$(ls "$CACHE/$name-${W}x$H-s25-"*.exr 2>/dev/null | head -n 1)
+	ref=$(ls "$CACHE/$name-${W}x$H-j15-"*.exr 2>/dev/null | head -n 1)
 	[[ -n $ref ]] || { echo "sampler: no cached reference for $name (run make sweep)" >&2; continue; }
 	"$PP" render "$scene" -o "$T/r.exr" -W $W -H $H --max-passes 1 --jobs 1 -q \
 		--workdir "$T/w" --keep-workdir -- +WT1

@@ -26,7 +26,7 @@ trap 'rm -rf "$T"' EXIT
 
 printf '%-17s %-6s %-5s %8s %10s %10s\n' scene target mode "CPU s" relMSE estimated
 for sc in "${scenes[@]}"; do
-	ref=$(ls "$CACHE/$sc-160x120-s25-"*.exr 2>/dev/null | head -n 1)
+	ref=$(ls "$CACHE/$sc-160x120-j15-"*.exr 2>/dev/null | head -n 1)
 	[[ -n $ref ]] || { echo "samplers.sh: no reference for $sc in $CACHE (make sweep)" >&2; exit 1; }
 	for t in 1e-3 3e-4; do
 		for m in ${MODES:-scale aa}; do
