@@ -1192,9 +1192,25 @@ static int word_at(const char *t, size_t i, const char *w)
 	return !before && !after;
 }
 
-/* Calls visit(t, i, ctx) at each index i of the scene text t outside
- * comments and strings. */
-static void scan_code(const char *t, void (*visit)(const char *t, size_t i, void *ctx), void *ctx)
+/* The number after the keyword at t[i] (sizeof key - 1 long), or NAN. */
+static double number_after(const char *t, size_t i, size_t keylen)
+{
+	const char *v = t + i + keylen;
+	char *end;
+	double x = strtod(v, &end);
+	return end == v ? NAN : x;
+}
+
+/* What the scene file (not what it includes) says outside comments and
+ * strings, for scene_focal_blur() and scene_assumed_gamma(). */
+struct scene_keys {
+	int aperture;		/* "aperture", but for "aperture 0" */
+	int blur_samples;
+	double gamma;		/* the last assumed_gamma given as a number, or 1 */
+};
+
+/* Scan the scene text t into *k, read once. */
+static void scene_scan(const char *t, struct scene_keys *k)
 {
 	for (size_t i = 0; t[i]; i++) {
 		if (t[i] == '/' && t[i + 1] == '/') {
@@ -1212,35 +1228,28 @@ static void scan_code(const char *t, void (*visit)(const char *t, size_t i, void
 				i++;
 			if (t[i + 1])
 				i++;
-		} else {
-			visit(t, i, ctx);
+		} else if (word_at(t, i, "aperture")) {
+			/* "aperture 0" is a camera without focal blur */
+			k->aperture |= !(number_after(t, i, sizeof "aperture" - 1) == 0.0);
+		} else if (word_at(t, i, "blur_samples")) {
+			k->blur_samples = 1;
+		} else if (word_at(t, i, "assumed_gamma")) {
+			double x = number_after(t, i, sizeof "assumed_gamma" - 1);
+			if (isfinite(x))
+				k->gamma = x;
 		}
 	}
 }
 
-/* The number after the keyword at t[i] (sizeof key - 1 long), or NAN. */
-static double number_after(const char *t, size_t i, size_t keylen)
+/* The scene file's keys (none where it cannot be read). */
+static struct scene_keys scene_read_keys(const char *path)
 {
-	const char *v = t + i + keylen;
-	char *end;
-	double x = strtod(v, &end);
-	return end == v ? NAN : x;
-}
-
-struct focal_scan {
-	int ap, bs;
-};
-
-static void focal_visit(const char *t, size_t i, void *ctx)
-{
-	struct focal_scan *f = ctx;
-	if (word_at(t, i, "aperture")) {
-		/* "aperture 0" is a camera without focal blur */
-		double x = number_after(t, i, sizeof "aperture" - 1);
-		f->ap |= !(x == 0.0);
-	} else {
-		f->bs |= word_at(t, i, "blur_samples");
-	}
+	struct scene_keys k = { 0, 0, 1.0 };
+	char *t = file_read_text(path);
+	if (t)
+		scene_scan(t, &k);
+	free(t);
+	return k;
 }
 
 /*
@@ -1256,15 +1265,9 @@ static void focal_visit(const char *t, size_t i, void *ctx)
  * scaling at 8 (64) 7.8e-5 and at 16 (256) 2.3e-5; on the other bundled
  * scenes the grid renders did as well as scaling or better (README).
  */
-static int scene_focal_blur(const char *path)
+static int scene_focal_blur(const struct scene_keys *k)
 {
-	char *t = file_read_text(path);
-	if (!t)
-		return 0;
-	struct focal_scan f = { 0, 0 };
-	scan_code(t, focal_visit, &f);
-	free(t);
-	return f.ap && f.bs;
+	return k->aperture && k->blur_samples;
 }
 
 /*
@@ -1283,23 +1286,9 @@ static int scene_focal_blur(const char *path)
  * 1.33e-3 in 7.5 s against 4.5e-4 in 8.5 s; lights/spotlite (2.2) at
  * --budget 3 5.3e-4 against 5.7e-5.
  */
-static void gamma_visit(const char *t, size_t i, void *ctx)
+static double scene_assumed_gamma(const struct scene_keys *k)
 {
-	if (word_at(t, i, "assumed_gamma")) {
-		double x = number_after(t, i, sizeof "assumed_gamma" - 1);
-		if (isfinite(x))
-			*(double *)ctx = x;
-	}
-}
-
-static double scene_assumed_gamma(const char *path)
-{
-	char *t = file_read_text(path);
-	if (!t)
-		return 0.0;
-	double g = 1.0;
-	scan_code(t, gamma_visit, &g);
-	free(t);
+	const double g = k->gamma;
 	return fabs(g - 1.0) > 0.01 && g > 0.0 ? g : 0.0;
 }
 
@@ -2374,8 +2363,9 @@ bad:
 			      strerror(errno));
 		goto fail_early;
 	}
-	r.focal = r.grid == PLAN_GRID_LARGE && !r.aa && scene_focal_blur(r.scene);
-	r.gamma = scene_assumed_gamma(r.scene);
+	const struct scene_keys keys = scene_read_keys(r.scene);
+	r.focal = r.grid == PLAN_GRID_LARGE && !r.aa && scene_focal_blur(&keys);
+	r.gamma = scene_assumed_gamma(&keys);
 	{
 		struct pov_job probe = { .scene = r.scene };
 		char bin[PATH_MAX];

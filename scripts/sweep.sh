@@ -195,9 +195,12 @@ for i in "${!scenes[@]}"; do
 done
 POV_VERSION=$(povray --version 2>&1 | grep -m1 '^POV-Ray' || true)
 [[ -n $POV_VERSION ]] || die "cannot tell povray's version ('povray --version')"
-# The reference's antialiasing: REF_SPP samples per render pixel.
-REF_AA=(+AM1 +A0.0 +R3 +J1.0)
-REF_SPP=10
+# The reference's antialiasing: +AM1 with a threshold of 0 supersamples
+# every render pixel with an R x R jittered grid and its centre, REF_SPP
+# samples.
+REF_R=3
+REF_AA=(+AM1 +A0.0 "+R$REF_R" +J1.0)
+REF_SPP=$((REF_R * REF_R + 1))
 REF_SETTINGS="povray -D -GA +FE +WT1 ${REF_AA[*]} at scale s, box-averaged by boxdown"
 
 mkdir -p "$CACHE" "$OUT"
