@@ -264,6 +264,7 @@ struct run {
 	double cost_job, cost_sample, latency;
 	double cost_sample_measured;	/* cost_sample before rounding (radiosity_time()) */
 	double tail;		/* the base pass's wait on POV-Ray's exit */
+	double pretrace_s;	/* the base pass's radiosity pretrace, CPU s */
 	int radiosity;
 	int rad_scale;		/* the scale the radiosity solution was computed at */
 	int jittered;		/* --sampler auto chose PLAN_GRID_ONLY for the run
@@ -913,13 +914,18 @@ static int radiosity_scale(const struct run *r)
  * (3.6e-3); started early (prelaunch_radiosity()), it waits only from its
  * gate, and ends the run at about 1.8 s with the reserve kept. */
 #define RAD_MARGIN 1.2	/* radiosity_pass(): the prediction's margin */
+/* A core's share of its time a whole-frame render on several has (Debian's
+ * gamma/gamma_showcase.pov at 320x240: 3.0 s wall on one thread, 1.73 to
+ * 1.83 s on two) */
+#define RAD_CORE_SHARE 0.85
 static double radiosity_time(const struct run *r, int k)
 {
 	/* a whole-frame render waits for POV-Ray's exit: the latency and the
 	 * tail the region renders do not wait on; one started early waits
 	 * only from its gate */
 	const double lat = rad_prelaunched(r, k) ? r->pre_latency : r->latency;
-	return lat + r->tail + r->cost_sample_measured * k * k * (double)r->w * r->h;
+	return lat + r->tail + r->pretrace_s +
+	       r->cost_sample_measured * k * k * (double)r->w * r->h;
 }
 
 /*
@@ -956,11 +962,27 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 		       r->budget)
 		k--;	/* radiosity_scale() chooses at most 4 */
 	double predicted = radiosity_time(r, k);
-	if (r->budget > 0.0 && elapsed(r) + predicted > r->budget) {
-		if (r->verbose)
-			fprintf(stderr, "povpress render: no radiosity pass: it would take about "
-				"%.1f s of the %.1f s budget\n", predicted, r->budget);
-		return 0;
+	int threads = 1;
+	if (r->budget > 0.0 && elapsed(r) + predicted + after > r->budget) {
+		/* on every core, when one would not do: the solution then
+		 * differs from run to run (below), but no pass leaves the
+		 * base pass's, computed on every core on the smallest frame
+		 * (Debian's gamma/gamma_showcase.pov at 160x120: relMSE 0.091
+		 * with it, 1.0e-3 with a solution on 320x240 on one thread
+		 * or two, three runs each) */
+		const double all = r->latency + r->tail +
+				   (r->pretrace_s + r->cost_sample_measured * k * k *
+							    (double)r->w * r->h) /
+					   (RAD_CORE_SHARE * r->cores);
+		if (r->cores < 2 || elapsed(r) + all + after > r->budget) {
+			if (r->verbose)
+				fprintf(stderr, "povpress render: no radiosity pass: it would take "
+					"about %.1f s of the %.1f s left\n",
+					r->cores < 2 ? predicted : all, r->budget - elapsed(r));
+			return 0;
+		}
+		threads = r->cores;
+		predicted = all;
 	}
 	char out[PATH_MAX], rad[PATH_MAX + 16];
 	snprintf(out, sizeof out, "%s", wpath(r, "radiosity.exr"));
@@ -969,11 +991,13 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	struct image img = {0}, acc = {0};
 	double t = now_s();
 	progress(r, "radiosity pass: %dx%d (%d x %d samples per pixel) for the radiosity "
-		 "solution", r->w * k, r->h * k, k, k);
-	/* one thread: on several POV-Ray computes another solution every run,
-	 * some much worse (radiosity_room at 640x480: relMSE 0.8e-3 to 2.6e-3
-	 * in three runs on two threads, 1.0e-3 on one; the same script) */
-	int ret = whole_frame(r, k, 1, out, rad, "radiosity pass", 0.0, &res, err, errlen);
+		 "solution%s, about %.1f s", r->w * k, r->h * k, k, k,
+		 threads > 1 ? " on every core" : "", predicted);
+	/* one thread but where that would not fit the budget: on several
+	 * POV-Ray computes another solution every run, some much worse
+	 * (radiosity_room at 640x480: relMSE 0.8e-3 to 2.6e-3 in three runs
+	 * on two threads, 1.0e-3 on one; the same script) */
+	int ret = whole_frame(r, k, threads, out, rad, "radiosity pass", 0.0, &res, err, errlen);
 	if (ret)
 		goto out;
 	ret = -1;
@@ -1484,9 +1508,18 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	/* the cost model */
 	const struct pov_stats *st = &res.stats;
 	double trace = (st->have & POV_HAVE_TRACE) ? st->trace.cpu_s : res.cpu_s;
-	/* camera samples: POV-Ray's "Rays" line counts reflected rays too */
+	/* camera samples: POV-Ray's "Rays" line counts reflected rays too,
+	 * and its "Pixels" line the radiosity pretrace's pixels, whose time
+	 * is the radiosity time's, not the trace's: the trace's samples are
+	 * the frame's (Debian's gamma/gamma_showcase.pov at 160x120 counts
+	 * 29809 pixels; so costed, its radiosity pass at scale 2 was
+	 * predicted at 1.2 s and took 2.7 s on one thread) */
 	double rays = st->pixels > 0 ? (double)(st->pixels + st->samples) : (double)r->w * r->h;
+	if (st->have & POV_HAVE_RADIOSITY)
+		rays = (double)r->w * r->h;
 	r->cost_sample = trace / rays;
+	/* the pretrace, which the radiosity pass repeats on one thread */
+	r->pretrace_s = (st->have & POV_HAVE_RADIOSITY) ? st->radiosity.cpu_s : 0.0;
 	if (!(r->cost_sample > 1e-9))
 		r->cost_sample = 1e-9;
 	double setup = res.cpu_s - trace;

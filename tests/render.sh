@@ -776,6 +776,29 @@ check "... and no render was started early" \
 	test "$(grep -o '"prelaunched": [1-9]' "$T/rp-off.json" | wc -l)" -eq 0
 check "... the same image either way (one thread, the same solution)" \
 	test "$("$PP" compare "$T/rp-on.exr" "$T/rp-off.exr" | sed -n 's/^relmse: //p')" = 0
+# a radiosity pass that one thread would not finish within the budget (a
+# sample costed at 1.6e-4 s: scale 2 at 80x60 about 3.1 s of the 3) runs on
+# every core where that fits (about 1.8 s on two), else not at all; a
+# wrapper standing in for POV-Ray logs the arguments of every render
+printf '#!/bin/sh\necho "$*" >>"$ARGS_LOG"\nexec povray "$@"\n' >"$T/argpov"
+chmod +x "$T/argpov"
+: >"$T/rt.args"
+ARGS_LOG="$T/rt.args" POVPRESS_POVRAY="$T/argpov" "$PP" render "$SC/radiosity_room.pov" \
+	-o "$T/rt.exr" -W 80 -H 60 --budget 3 --cost-sample 1.6e-4 --report "$T/rt.json" \
+	-q 2>"$T/rt.err"
+rtrc=$?
+ncores=$(nproc)
+check "radiosity pass that one thread would not fit in the budget: the run succeeds" \
+	test "$rtrc" -eq 0
+if ((ncores > 1)); then
+	check "... on $ncores cores: the pass at scale 2 runs on all of them (+WT$ncores)" \
+		grep -q -- "+W160 +H120 +WT$ncores .*+RFO" "$T/rt.args"
+	check "... and the report names its scale" grep -q '"radiosity_scale": 2' "$T/rt.json"
+else
+	check "... on one core: no radiosity pass (no 160x120 render saving a solution)" \
+		test "$(grep -c -- '+W160 +H120 .*+RFO' "$T/rt.args")" -eq 0
+fi
+check "... the output is a complete image" valid_exr "$T/rt.exr"
 # interrupted while the early renders wait at their gates
 "$PP" render "$SC/focal_blur.pov" -o "$T/pl-int.exr" -W $W -H $H --budget 5 --target 1e-6 \
 	--prelaunch on -q --workdir "$T/pl int" &
