@@ -691,6 +691,54 @@ static int merge_region(struct image *acc, const struct image *img, int oy, int 
 	return 0;
 }
 
+int accum_split_diff(struct image *acc, const struct image *img, int s, char *err,
+		     size_t errlen)
+{
+	const int ir = image_channel(img, "R"), ig = image_channel(img, "G"),
+		  ib = image_channel(img, "B");
+	if (ir < 0 || ig < 0 || ib < 0) {
+		errbuf_printf(err, errlen, "the render has no R, G and B channels");
+		return -1;
+	}
+	if (s < 2 || img->w != acc->w * s || img->h != acc->h * s) {
+		errbuf_printf(err, errlen, "the render is %dx%d, not %dx%d at scale %d (2 or more)",
+			      img->w, img->h, acc->w * s, acc->h * s, s);
+		return -1;
+	}
+	const int ch[3] = { ir, ig, ib };
+	for (int y = 0; y < acc->h; y++)
+		for (int x = 0; x < acc->w; x++) {
+			float *o = acc->px + ((size_t)y * acc->w + x) * ACC_NCH;
+			double sum[2][3] = { { 0.0, 0.0, 0.0 }, { 0.0, 0.0, 0.0 } };
+			int n[2] = { 0, 0 }, ok = 1;
+			for (int j = 0; j < s && ok; j++)
+				for (int k = 0; k < s; k++) {
+					const float *p = img->px +
+						(((size_t)y * s + j) * img->w + (size_t)x * s + k) * img->nch;
+					if (!isfinite(p[ir]) || !isfinite(p[ig]) || !isfinite(p[ib])) {
+						ok = 0;
+						break;
+					}
+					const int h = (j + k) & 1;
+					for (int c = 0; c < 3; c++)
+						sum[h][c] += p[ch[c]];
+					n[h]++;
+				}
+			if (!ok || !n[0] || !n[1] || o[ACC_SAMPLES] != (float)(n[0] + n[1]))
+				continue;
+			/* as accum_fold() would have it, the second half folded
+			 * onto the first */
+			const double na = n[0], nb = n[1], nt = na + nb;
+			double d2 = 0.0;
+			for (int c = 0; c < 3; c++) {
+				const double d = sum[1][c] / nb - sum[0][c] / na;
+				d2 += d * d / ((double)o[c] * o[c] + METRICS_RELMSE_EPS) / 3.0;
+			}
+			o[ACC_DIFF] = (float)(d2 * na * nb / (nt * nt));
+		}
+	return 0;
+}
+
 int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
 		       int y0, int x1, int y1, int pass, long *folded, char *err,
 		       size_t errlen)

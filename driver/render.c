@@ -1016,7 +1016,8 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	}
 	long folded = 0;
 	if (accum_merge_region(&acc, &img, 0, k, 0, 0, r->w - 1, r->h - 1, 0, &folded, err,
-			       errlen))
+			       errlen) ||
+	    accum_split_diff(&acc, &img, k, err, errlen))
 		goto out;
 	if (rename(rad, r->radfile)) {
 		errbuf_printf(err, errlen, "cannot rename '%s' to '%s': %s", rad, r->radfile,

@@ -528,6 +528,59 @@ static void test_merge_region(void **state)
 	image_release(&acc);
 }
 
+/* A radiosity pass's frame folded into a fresh accumulation: its pixels'
+ * difference from their samples' two checkerboard halves. */
+static void test_split_diff(void **state)
+{
+	const int W = 3, H = 1, S = 4;
+	struct image acc, img, bad;
+	char err[256];
+	long folded = 0;
+
+	(void)state;
+	assert_int_equal(image_init(&acc, W, H, ACC_NCH, accum_names, err, sizeof(err)), 0);
+	for (size_t i = 0; i < (size_t)W * H; i++)
+		accpx(&acc, i)[ACC_DIFF] = NAN;
+	assert_int_equal(image_init(&img, W * S, H * S, 3, rgb_names, err, sizeof(err)), 0);
+	for (int y = 0; y < S; y++)
+		for (int X = 0; X < W * S; X++)
+			for (int c = 0; c < 3; c++) {
+				const int x = X / S, k = X % S, odd = (y + k) & 1;
+				/* pixel 0: 1 on even, 0.5 on odd positions;
+				 * pixel 1: flat 0.25; pixel 2: one missing */
+				float v = x == 0 ? (odd ? 0.5f : 1.0f) : 0.25f;
+				if (x == 2 && y == 1 && k == 2)
+					v = NAN;
+				img.px[((size_t)y * img.w + X) * 3 + c] = v;
+			}
+	assert_int_equal(accum_merge_region(&acc, &img, 0, S, 0, 0, W - 1, H - 1, 0, &folded,
+					    err, sizeof(err)), 0);
+	assert_int_equal(folded, 3);
+	assert_true(isnan(accpx(&acc, 0)[ACC_DIFF]));	/* no fold onto samples */
+	assert_int_equal(accum_split_diff(&acc, &img, S, err, sizeof(err)), 0);
+	/* 8 samples onto 8: d^2 / (m^2 + 0.01) x 8 x 8 / 16^2, d = -0.5,
+	 * m = 0.75 */
+	assert_close(accpx(&acc, 0)[ACC_DIFF], 0.25 / (0.5625 + METRICS_RELMSE_EPS) / 4.0, 1e-6,
+		     0.0, "checkerboard pixel");
+	assert_true(accpx(&acc, 1)[ACC_DIFF] == 0.0f);
+	assert_true(accpx(&acc, 2)[ACC_SAMPLES] == 15.0f);
+	assert_true(isnan(accpx(&acc, 2)[ACC_DIFF]));	/* a sample missing: left */
+	/* a pixel that had samples before is not the render's alone */
+	accpx(&acc, 1)[ACC_SAMPLES] = 17.0f;
+	accpx(&acc, 1)[ACC_DIFF] = 0.5f;
+	assert_int_equal(accum_split_diff(&acc, &img, S, err, sizeof(err)), 0);
+	assert_true(accpx(&acc, 1)[ACC_DIFF] == 0.5f);
+	/* not a frame at that scale: an error, nothing changed */
+	make_render(&bad, W * S - 1, 0, H * S, S);
+	err[0] = '\0';
+	assert_int_equal(accum_split_diff(&acc, &bad, S, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "not 12x4 at scale 4"));
+	assert_true(accpx(&acc, 1)[ACC_DIFF] == 0.5f);
+	image_release(&bad);
+	image_release(&img);
+	image_release(&acc);
+}
+
 /* 3. A non-finite sub-sample is skipped; a block of them adds nothing. */
 static void test_merge_nonfinite(void **state)
 {
@@ -2164,6 +2217,7 @@ int main(void)
 		cmocka_unit_test(test_fold),
 		cmocka_unit_test(test_merge_region),
 		cmocka_unit_test(test_merge_nonfinite),
+		cmocka_unit_test(test_split_diff),
 		cmocka_unit_test(test_merge_aa),
 		cmocka_unit_test(test_merge_aa_edges),
 		cmocka_unit_test(test_merge_grid),
