@@ -211,6 +211,15 @@ int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
  * be: see struct strat in accum.c).  *folded counts the pixels that took
  * new samples (may be NULL).  Fails on a size mismatch or rows not read.
  */
+int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
+		       int y0, int x1, int y1, int pass, long *folded, char *err,
+		       size_t errlen);
+
+/* The same from the render's file at path, reading only the rows the
+ * rectangle needs (the render's size is read from the file first). */
+int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
+		     int y1, int pass, long *folded, char *err, size_t errlen);
+
 /*
  * A whole frame's s x s samples a pixel folded into pixels that had none (a
  * radiosity pass, accum_merge_region() at scale s onto a fresh
@@ -227,15 +236,6 @@ int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
  */
 int accum_split_diff(struct image *acc, const struct image *img, int s, char *err,
 		     size_t errlen);
-
-int accum_merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
-		       int y0, int x1, int y1, int pass, long *folded, char *err,
-		       size_t errlen);
-
-/* The same from the render's file at path, reading only the rows the
- * rectangle needs (the render's size is read from the file first). */
-int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
-		     int y1, int pass, long *folded, char *err, size_t errlen);
 
 /* accum_merge_region() and accum_merge_file() of an antialiased render in
  * scale 2's place (s ACC_AA, twice the image's size) taken for edges, at
