@@ -700,11 +700,13 @@ int accum_split_diff(struct image *acc, const struct image *img, int s, char *er
 		errbuf_printf(err, errlen, "the render has no R, G and B channels");
 		return -1;
 	}
-	if (s < 2 || img->w != acc->w * s || img->h != acc->h * s) {
-		errbuf_printf(err, errlen, "the render is %dx%d, not %dx%d at scale %d (2 or more)",
+	if (s < 1 || img->w != acc->w * s || img->h != acc->h * s) {
+		errbuf_printf(err, errlen, "the render is %dx%d, not %dx%d at scale %d",
 			      img->w, img->h, acc->w * s, acc->h * s, s);
 		return -1;
 	}
+	if (s == 1)	/* one sample a pixel: no halves */
+		return 0;
 	const int ch[3] = { ir, ig, ib };
 	for (int y = 0; y < acc->h; y++)
 		for (int x = 0; x < acc->w; x++) {
@@ -991,8 +993,9 @@ double accum_pixel_noise(const struct image *acc, size_t i, double diff)
 		return NAN;
 	if (isfinite(diff))
 		return diff * value_bias(o);
-	/* samples from a single render (a radiosity pass): the variance of
-	 * their mean */
+	/* samples from a single render with no split of them to compare (a
+	 * radiosity pass whose pixels had a sample missing; one at scale 1
+	 * has a sample a pixel): the variance of their mean */
 	double v[3];
 	for (int c = 0; c < 3; c++)
 		v[c] = o[ACC_VAR_R + c] / n;

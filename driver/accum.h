@@ -231,8 +231,8 @@ int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0,
  * checkerboard halves (x + y even and odd), as accum_fold() would have
  * folding the one onto the other.  img is the frame at s times acc's size;
  * pixels with a sample missing, or not of that render alone (their count
- * other than s x s), are left.  Returns 0, or -1 (the message in err) when
- * img is not such a frame.
+ * other than s x s), are left, and at s = 1 (a sample a pixel) all are.
+ * Returns 0, or -1 (the message in err) when img is not such a frame.
  */
 int accum_split_diff(struct image *acc, const struct image *img, int s, char *err,
 		     size_t errlen);

@@ -974,11 +974,14 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 				   (r->pretrace_s + r->cost_sample_measured * k * k *
 							    (double)r->w * r->h) /
 					   (RAD_CORE_SHARE * r->cores);
-		if (r->cores < 2 || elapsed(r) + all + after > r->budget) {
+		/* (at scale 1 on every core it would be the base pass again) */
+		if (r->cores < 2 || k < 2 || elapsed(r) + all + after > r->budget) {
+			const double room = r->budget - elapsed(r) - after;
 			if (r->verbose)
 				fprintf(stderr, "povpress render: no radiosity pass: it would take "
-					"about %.1f s of the %.1f s left\n",
-					r->cores < 2 ? predicted : all, r->budget - elapsed(r));
+					"about %.1f s, and %.1f s are left for it\n",
+					r->cores < 2 || k < 2 ? predicted : all,
+					room > 0.0 ? room : 0.0);
 			return 0;
 		}
 		threads = r->cores;

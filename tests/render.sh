@@ -777,19 +777,22 @@ check "... and no render was started early" \
 check "... the same image either way (one thread, the same solution)" \
 	test "$("$PP" compare "$T/rp-on.exr" "$T/rp-off.exr" | sed -n 's/^relmse: //p')" = 0
 # a radiosity pass that one thread would not finish within the budget (a
-# sample costed at 1.6e-4 s: scale 2 at 80x60 about 3.1 s of the 3) runs on
-# every core where that fits (about 1.8 s on two), else not at all; a
-# wrapper standing in for POV-Ray logs the arguments of every render
+# sample costed at 2.2e-4 s: scale 2 at 80x60 about 4.3 s of the 4) runs on
+# every core where that fits (about 2.5 s on two), else not at all; a
+# wrapper standing in for POV-Ray logs the arguments of every render (no
+# renders started early, whose arguments it would log too)
 printf '#!/bin/sh\necho "$*" >>"$ARGS_LOG"\nexec povray "$@"\n' >"$T/argpov"
 chmod +x "$T/argpov"
 : >"$T/rt.args"
 ARGS_LOG="$T/rt.args" POVPRESS_POVRAY="$T/argpov" "$PP" render "$SC/radiosity_room.pov" \
-	-o "$T/rt.exr" -W 80 -H 60 --budget 3 --cost-sample 1.6e-4 --report "$T/rt.json" \
-	-q 2>"$T/rt.err"
+	-o "$T/rt.exr" -W 80 -H 60 --budget 4 --cost-sample 2.2e-4 --prelaunch off \
+	--report "$T/rt.json" -q 2>"$T/rt.err"
 rtrc=$?
-ncores=$(nproc)
+ncores=$(env -u OMP_NUM_THREADS nproc)	# as povpress counts them: the affinity mask
 check "radiosity pass that one thread would not fit in the budget: the run succeeds" \
 	test "$rtrc" -eq 0
+check "... the wrapper logged the base pass (80x60, saving the radiosity data)" \
+	grep -q -- "+W80 +H60 .*+RFO" "$T/rt.args"
 if ((ncores > 1)); then
 	check "... on $ncores cores: the pass at scale 2 runs on all of them (+WT$ncores)" \
 		grep -q -- "+W160 +H120 +WT$ncores .*+RFO" "$T/rt.args"
@@ -799,6 +802,12 @@ else
 		test "$(grep -c -- '+W160 +H120 .*+RFO' "$T/rt.args")" -eq 0
 fi
 check "... the output is a complete image" valid_exr "$T/rt.exr"
+# at 480 pixels wide the radiosity pass is at scale 1, on one thread after a
+# base pass on every core (on one core there is none): a sample a pixel
+"$PP" render "$SC/radiosity_room.pov" -o "$T/r1.exr" -W 480 -H 360 --max-passes 0 \
+	--report "$T/r1.json" -q 2>"$T/r1.err"
+check "radiosity at 480x360 (a radiosity pass at scale 1): the run succeeds" test $? -eq 0
+check "... the output is a complete image" valid_exr "$T/r1.exr"
 # interrupted while the early renders wait at their gates
 "$PP" render "$SC/focal_blur.pov" -o "$T/pl-int.exr" -W $W -H $H --budget 5 --target 1e-6 \
 	--prelaunch on -q --workdir "$T/pl int" &

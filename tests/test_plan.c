@@ -577,6 +577,39 @@ static void test_split_diff(void **state)
 	assert_non_null(strstr(err, "not 12x4 at scale 4"));
 	assert_true(accpx(&acc, 1)[ACC_DIFF] == 0.5f);
 	image_release(&bad);
+	/* scale 1 (a radiosity pass on a frame 480 pixels wide or more): one
+	 * sample a pixel, no halves, nothing changed and no error */
+	struct image a1, one;
+	assert_int_equal(image_init(&a1, W, H, ACC_NCH, accum_names, err, sizeof(err)), 0);
+	for (size_t i = 0; i < (size_t)W * H; i++)
+		accpx(&a1, i)[ACC_DIFF] = NAN;
+	make_render(&one, W, 0, H, 1);
+	assert_int_equal(accum_merge_region(&a1, &one, 0, 1, 0, 0, W - 1, H - 1, 0, &folded,
+					    err, sizeof(err)), 0);
+	assert_int_equal(accum_split_diff(&a1, &one, 1, err, sizeof(err)), 0);
+	for (size_t i = 0; i < (size_t)W * H; i++)
+		assert_true(isnan(accpx(&a1, i)[ACC_DIFF]));
+	image_release(&one);
+	image_release(&a1);
+	/* scale 3 (a radiosity pass under a budget): halves of 5 and 4 */
+	struct image a3, three;
+	assert_int_equal(image_init(&a3, 1, 1, ACC_NCH, accum_names, err, sizeof(err)), 0);
+	accpx(&a3, 0)[ACC_DIFF] = NAN;
+	assert_int_equal(image_init(&three, 3, 3, 3, rgb_names, err, sizeof(err)), 0);
+	for (int k = 0; k < 9; k++)
+		for (int c = 0; c < 3; c++)	/* even positions 1, odd 0.1 c */
+			three.px[k * 3 + c] = (k % 2 == 0) ? 1.0f : 0.1f * (float)c;
+	assert_int_equal(accum_merge_region(&a3, &three, 0, 3, 0, 0, 0, 0, 0, &folded, err,
+					    sizeof(err)), 0);
+	assert_int_equal(accum_split_diff(&a3, &three, 3, err, sizeof(err)), 0);
+	double want = 0.0;
+	for (int c = 0; c < 3; c++) {
+		const double m = (5.0 + 4.0 * 0.1 * c) / 9.0, d = 0.1 * c - 1.0;
+		want += d * d / (m * m + METRICS_RELMSE_EPS) / 3.0;
+	}
+	assert_close(accpx(&a3, 0)[ACC_DIFF], want * 5.0 * 4.0 / 81.0, 1e-5, 0.0, "scale 3");
+	image_release(&three);
+	image_release(&a3);
 	image_release(&img);
 	image_release(&acc);
 }
