@@ -620,6 +620,19 @@ static int scaled_pixel(const struct image *img, int oy, const int ch[3], int s,
 	return n;
 }
 
+/* A render's R, G and B channels, into ch; -1 (the message in err) when it
+ * lacks one. */
+static int render_rgb(const struct image *img, int ch[3], char *err, size_t errlen)
+{
+	static const char *const name[3] = { "R", "G", "B" };
+	for (int c = 0; c < 3; c++)
+		if ((ch[c] = image_channel(img, name[c])) < 0) {
+			errbuf_printf(err, errlen, "the render has no R, G and B channels");
+			return -1;
+		}
+	return 0;
+}
+
 static int merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
 			int y0, int x1, int y1, int pass, int edges, long *folded, char *err,
 			size_t errlen)
@@ -653,13 +666,9 @@ static int merge_region(struct image *acc, const struct image *img, int oy, int 
 			      (y1 + 1) * f - 1);
 		return -1;
 	}
-	int ir = image_channel(img, "R"), ig = image_channel(img, "G"),
-	    ib = image_channel(img, "B");
-	if (ir < 0 || ig < 0 || ib < 0) {
-		errbuf_printf(err, errlen, "the render has no R, G and B channels");
+	int ch[3];
+	if (render_rgb(img, ch, err, errlen))
 		return -1;
-	}
-	const int ch[3] = { ir, ig, ib };
 	if (s == ACC_AA || grid) {
 		long c = s == ACC_AA ? merge_aa(acc, img, oy, ch, f, x0, y0, x1, y1, pass, edges)
 				     : merge_grid(acc, img, oy, ch, s, x0, y0, x1, y1, pass);
@@ -694,12 +703,9 @@ static int merge_region(struct image *acc, const struct image *img, int oy, int 
 int accum_split_diff(struct image *acc, const struct image *img, int s, char *err,
 		     size_t errlen)
 {
-	const int ir = image_channel(img, "R"), ig = image_channel(img, "G"),
-		  ib = image_channel(img, "B");
-	if (ir < 0 || ig < 0 || ib < 0) {
-		errbuf_printf(err, errlen, "the render has no R, G and B channels");
+	int ch[3];
+	if (render_rgb(img, ch, err, errlen))
 		return -1;
-	}
 	if (s < 1 || img->w != acc->w * s || img->h != acc->h * s) {
 		errbuf_printf(err, errlen, "the render is %dx%d, not %dx%d at scale %d",
 			      img->w, img->h, acc->w * s, acc->h * s, s);
@@ -707,30 +713,28 @@ int accum_split_diff(struct image *acc, const struct image *img, int s, char *er
 	}
 	if (s == 1)	/* one sample a pixel: no halves */
 		return 0;
-	const int ch[3] = { ir, ig, ib };
+	/* the halves' counts: (j + k) even, then odd, over the s x s */
+	const double na = (s * s + 1) / 2, nb = s * s / 2, nt = na + nb;
 	for (int y = 0; y < acc->h; y++)
 		for (int x = 0; x < acc->w; x++) {
 			float *o = acc->px + ((size_t)y * acc->w + x) * ACC_NCH;
+			if (o[ACC_SAMPLES] != (float)nt)
+				continue;
 			double sum[2][3] = { { 0.0, 0.0, 0.0 }, { 0.0, 0.0, 0.0 } };
-			int n[2] = { 0, 0 }, ok = 1;
-			for (int j = 0; j < s && ok; j++)
+			int ok = 1;
+			for (int j = 0; j < s; j++)
 				for (int k = 0; k < s; k++) {
 					const float *p = img->px +
 						(((size_t)y * s + j) * img->w + (size_t)x * s + k) * img->nch;
-					if (!isfinite(p[ir]) || !isfinite(p[ig]) || !isfinite(p[ib])) {
-						ok = 0;
-						break;
+					for (int c = 0; c < 3; c++) {
+						ok &= isfinite(p[ch[c]]) != 0;
+						sum[(j + k) & 1][c] += p[ch[c]];
 					}
-					const int h = (j + k) & 1;
-					for (int c = 0; c < 3; c++)
-						sum[h][c] += p[ch[c]];
-					n[h]++;
 				}
-			if (!ok || !n[0] || !n[1] || o[ACC_SAMPLES] != (float)(n[0] + n[1]))
+			if (!ok)
 				continue;
 			/* as accum_fold() would have it, the second half folded
 			 * onto the first */
-			const double na = n[0], nb = n[1], nt = na + nb;
 			double d2 = 0.0;
 			for (int c = 0; c < 3; c++) {
 				const double d = sum[1][c] / nb - sum[0][c] / na;

@@ -918,14 +918,14 @@ static int radiosity_scale(const struct run *r)
  * gamma/gamma_showcase.pov at 320x240: 3.0 s wall on one thread, 1.73 to
  * 1.83 s on two) */
 #define RAD_CORE_SHARE 0.85
-static double radiosity_time(const struct run *r, int k)
+static double radiosity_time(const struct run *r, int k, int threads)
 {
 	/* a whole-frame render waits for POV-Ray's exit: the latency and the
-	 * tail the region renders do not wait on; one started early waits
-	 * only from its gate */
-	const double lat = rad_prelaunched(r, k) ? r->pre_latency : r->latency;
-	return lat + r->tail + r->pretrace_s +
-	       r->cost_sample_measured * k * k * (double)r->w * r->h;
+	 * tail the region renders do not wait on; one started early (on one
+	 * thread) waits only from its gate */
+	const double lat = threads == 1 && rad_prelaunched(r, k) ? r->pre_latency : r->latency;
+	const double work = r->pretrace_s + r->cost_sample_measured * k * k * (double)r->w * r->h;
+	return lat + r->tail + (threads > 1 ? work / (RAD_CORE_SHARE * threads) : work);
 }
 
 /*
@@ -952,40 +952,35 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	const double after = 0.1 + 2e-6 * (double)r->w * r->h;
 	/* and the pass may take longer than predicted: started early at scale
 	 * 4 there, predicted to end the run by 1.85 s, it ended it at 2.00 to
-	 * 2.04 s (the radiosity pretrace and the larger solution's write are
-	 * not in the prediction).  The margin guards the step from 4 to 3,
+	 * 2.04 s (the larger solution's write is not in the prediction, nor
+	 * was the radiosity pretrace then).  The margin guards the step from 4 to 3,
 	 * whose image (1.63e-3 there) is a fair fallback, not the one from 3
 	 * to 2: scale 2's (3.6e-3) is more than twice POV-Ray's own scale 3 at
 	 * that CPU, and with the margin one run in six took it */
 	while (r->budget > 0.0 && r->user_rad_scale < 0 && k > 2 &&
-	       elapsed(r) + (k > 3 ? RAD_MARGIN : 1.0) * radiosity_time(r, k) + after >
+	       elapsed(r) + (k > 3 ? RAD_MARGIN : 1.0) * radiosity_time(r, k, 1) + after >
 		       r->budget)
 		k--;	/* radiosity_scale() chooses at most 4 */
-	double predicted = radiosity_time(r, k);
 	int threads = 1;
-	if (r->budget > 0.0 && elapsed(r) + predicted + after > r->budget) {
+	double predicted = radiosity_time(r, k, 1);
+	const double room = r->budget - elapsed(r) - after;
+	if (r->budget > 0.0 && predicted > room) {
 		/* on every core, when one would not do: the solution then
 		 * differs from run to run (below), but no pass leaves the
 		 * base pass's, computed on every core on the smallest frame
 		 * (Debian's gamma/gamma_showcase.pov at 160x120: relMSE 0.091
 		 * with it, 1.0e-3 with a solution on 320x240 on one thread
-		 * or two, three runs each) */
-		const double all = r->latency + r->tail +
-				   (r->pretrace_s + r->cost_sample_measured * k * k *
-							    (double)r->w * r->h) /
-					   (RAD_CORE_SHARE * r->cores);
-		/* (at scale 1 on every core it would be the base pass again) */
-		if (r->cores < 2 || k < 2 || elapsed(r) + all + after > r->budget) {
-			const double room = r->budget - elapsed(r) - after;
+		 * (one run) or two (three)); not at scale 1, where that would
+		 * be the base pass again */
+		threads = r->cores > 1 && k > 1 ? r->cores : 1;
+		predicted = radiosity_time(r, k, threads);
+		if (threads == 1 || predicted > room) {
 			if (r->verbose)
 				fprintf(stderr, "povpress render: no radiosity pass: it would take "
 					"about %.1f s, and %.1f s are left for it\n",
-					r->cores < 2 || k < 2 ? predicted : all,
-					room > 0.0 ? room : 0.0);
+					predicted, room > 0.0 ? room : 0.0);
 			return 0;
 		}
-		threads = r->cores;
-		predicted = all;
 	}
 	char out[PATH_MAX], rad[PATH_MAX + 16];
 	snprintf(out, sizeof out, "%s", wpath(r, "radiosity.exr"));
@@ -1518,9 +1513,9 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	 * the frame's (Debian's gamma/gamma_showcase.pov at 160x120 counts
 	 * 29809 pixels; so costed, its radiosity pass at scale 2 was
 	 * predicted at 1.2 s and took 2.7 s on one thread) */
-	double rays = st->pixels > 0 ? (double)(st->pixels + st->samples) : (double)r->w * r->h;
-	if (st->have & POV_HAVE_RADIOSITY)
-		rays = (double)r->w * r->h;
+	const double rays = st->pixels > 0 && !(st->have & POV_HAVE_RADIOSITY) ?
+				    (double)(st->pixels + st->samples) :
+				    (double)r->w * r->h;
 	r->cost_sample = trace / rays;
 	/* the pretrace, which the radiosity pass repeats on one thread */
 	r->pretrace_s = (st->have & POV_HAVE_RADIOSITY) ? st->radiosity.cpu_s : 0.0;

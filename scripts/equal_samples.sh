@@ -29,7 +29,7 @@ printf '%-18s %7s %10s %10s %7s %9s\n' scene spp povpress uniform ratio est/true
 for name in "${names[@]}"; do
 	scene="$ROOT/scenes/$name.pov"
 	ref=$(ls "$CACHE/$name-${W}x$H-j15-"*.exr 2>/dev/null | head -n 1)
-	[[ -n $ref ]] || { echo "equal_samples: no reference for $name (run make check)" >&2; exit 1; }
+	[[ -n $ref ]] || { echo "equal_samples: no reference for $name (run make sweep)" >&2; exit 1; }
 	: >"$T/uni"
 	for s in 1 2 3 4 5 6 7 8 9 10; do
 		povray -D -GA +FE -A +WT1 +W$((s * W)) +H$((s * H)) "+I\"$scene\"" \
