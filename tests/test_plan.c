@@ -965,10 +965,11 @@ static void test_merge_aa_edges(void **state)
 	image_release(&plain);
 
 	/* hidden edges: pixel 0 beside a pixel 0.6 brighter, with 8
-	 * samples and no spread each; as edge pixels the difference that
-	 * counts is at most the threshold / 3; and where POV-Ray subdivided
-	 * the neighbour (ACC_AA_DEEP) and not pixel 0, the edge is the
-	 * neighbour's: none is charged to pixel 0 */
+	 * samples each, pixel 0's render pixels apart by 0.02 (a spread
+	 * whose ACC_AA_STEP_SD reaches past the cap); as edge pixels the
+	 * difference that counts is at most the threshold / 3; and where
+	 * POV-Ray subdivided the neighbour (ACC_AA_DEEP) and not pixel 0, the
+	 * edge is the neighbour's: none is charged to pixel 0 */
 	struct image two;
 	make_acc(&two, 2, 1, flat_value);
 	double e[3];
@@ -977,7 +978,7 @@ static void test_merge_aa_edges(void **state)
 			float *o = accpx(&two, (size_t)x);
 			for (int c = 0; c < 3; c++) {
 				o[c] = (float)(0.2 + 0.6 * x);
-				o[ACC_VAR_R + c] = 0.0f;
+				o[ACC_VAR_R + c] = x ? 0.0f : 0.02f * 0.02f;
 			}
 			o[ACC_SAMPLES] = 8.0f;
 			o[ACC_SCALES] = (float)(1u << 1 | 1u << 2 | 1u << ACC_AA | 1u << ACC_AA_HALF |
@@ -996,6 +997,23 @@ static void test_merge_aa_edges(void **state)
 	cap *= 0.5;	/* on this pixel's side: 2 / (2 + 2) */
 	assert_true(e[0] > 10.0 * e[1]);
 	assert_close(e[1], cap, 1e-6, 1e-15, "the hidden edge at most the threshold");
+	/* pixel 0's render pixels alike to 0.005: the step its own render
+	 * pixels could hide, ACC_AA_STEP_SD of that, in place of the cap;
+	 * alike to the last bit: none (the step is the neighbour's) */
+	double small = 0.0, t = ACC_AA_STEP_SD * 0.005;
+	for (int c = 0; c < 3; c++)
+		for (int k = 0; k < 4; k++) {
+			double m = (k + 0.5) / 16.0 * t;
+			small += 0.5 * m * m / ((0.2 + m) * (0.2 + m) + METRICS_RELMSE_EPS) / 12.0;
+		}
+	for (int c = 0; c < 3; c++)
+		accpx(&two, 0)[ACC_VAR_R + c] = 0.005f * 0.005f;
+	accpx(&two, 1)[ACC_SCALES] = accpx(&two, 0)[ACC_SCALES];
+	assert_close(accum_pixel_error(&two, 0, NAN, NULL, 0.0), small, 1e-4, 1e-15,
+		     "the hidden edge at most what the render pixels show");
+	for (int c = 0; c < 3; c++)
+		accpx(&two, 0)[ACC_VAR_R + c] = 0.0f;
+	assert_true(accum_pixel_error(&two, 0, NAN, NULL, 0.0) == 0.0);
 	image_release(&two);
 
 	/* a grid render of scale 4 over them: all 4 x 5 samples new (the
@@ -1640,6 +1658,74 @@ static double mixed_value(int x, int y, int c)
 	return 0.1 + 0.6 * ((x / 5 + y / 7) % 2) + 0.05 * c + 0.002 * x;
 }
 
+/*
+ * Edges a neighbour's samples already place.  A diagonal neighbour 0.6
+ * brighter than the dark pixel 0 (3 x 3 pixels around, all 8 samples with
+ * no spread): charged as a hidden edge while the two pixels beside both
+ * are flat, not when either holds the step in its samples (a lamp's rim).
+ * A one-sample pixel beside a pixel POV-Ray subdivided for an edge (its
+ * mean 0.035 below, its samples spread 0.05): its range bound counts the
+ * neighbour at the nearest of its mean +- spread, here the pixel's own
+ * value; without the subdivision the full 0.035.
+ */
+static void test_pixel_errors_edges(void **state)
+{
+	struct image acc;
+	float fit[3] = { 0.2f, 0.2f, 0.2f };
+
+	(void)state;
+	make_acc(&acc, 3, 3, flat_value);
+	for (int y = 0; y < 3; y++)
+		for (int x = 0; x < 3; x++) {
+			set_px(&acc, x, y, 8.0f, 0.0f, 0.0f);
+			float *o = accpx(&acc, (size_t)y * 3 + x);
+			o[ACC_SCALES] = 2 + 4 + 16;
+			for (int c = 0; c < 3; c++)
+				o[c] = 0.01f;
+		}
+	/* pixel (0, 0) dark, its diagonal (1, 1) bright; (2, *) and (*, 2)
+	 * dark like it */
+	for (int c = 0; c < 3; c++)
+		accpx(&acc, 4)[c] = 0.61f;
+	double flat = accum_pixel_error(&acc, 0, 1e-6, fit, accum_pixel_noise(&acc, 0, 0.0));
+	assert_true(flat > 0.05);
+	/* (1, 0) holds the rim: samples from dark to bright */
+	for (int c = 0; c < 3; c++) {
+		accpx(&acc, 1)[c] = 0.3f;
+		accpx(&acc, 1)[ACC_VAR_R + c] = 0.6f * 0.6f / 4.0f;
+	}
+	double rim = accum_pixel_error(&acc, 0, 1e-6, fit, accum_pixel_noise(&acc, 0, 0.0));
+	/* (1, 0) itself an edge-on neighbour with its spread: nothing left */
+	assert_true(rim == 0.0);
+	/* the rim's spread too small to hold the step: charged again */
+	for (int c = 0; c < 3; c++)
+		accpx(&acc, 1)[ACC_VAR_R + c] = 0.01f * 0.01f;
+	assert_true(accum_pixel_error(&acc, 0, 1e-6, fit, accum_pixel_noise(&acc, 0, 0.0)) >
+		    0.5 * flat);
+	image_release(&acc);
+
+	/* one row: a one-sample pixel (0.41) beside a subdivided one (mean
+	 * 0.375, spread 0.05) and beside its like (0.41) */
+	make_acc(&acc, 3, 1, flat_value);
+	const float val[3] = { 0.41f, 0.41f, 0.375f };
+	for (int x = 0; x < 3; x++) {
+		float *o = accpx(&acc, (size_t)x);
+		for (int c = 0; c < 3; c++)
+			o[c] = val[x];
+	}
+	set_px(&acc, 2, 0, 257.0f, 0.05f * 0.05f, 1e-6f);
+	accpx(&acc, 2)[ACC_SCALES] = (float)(1u << 1 | 1u << 2 | 1u << ACC_AA | 1u << ACC_AA_HALF |
+					     1u << ACC_AA_EDGE | 1u << ACC_AA_DEEP);
+	const double range = 0.035 * 0.035 / (0.375 * 0.375 + METRICS_RELMSE_EPS);
+	double deep = accum_pixel_error(&acc, 1, 1.0, val, NAN);
+	assert_true(deep < 1e-4 * range);
+	accpx(&acc, 2)[ACC_SCALES] = (float)(1u << 1 | 1u << 2 | 1u << ACC_AA | 1u << ACC_AA_HALF |
+					     1u << ACC_AA_EDGE);
+	assert_close(accum_pixel_error(&acc, 1, 1.0, val, NAN), range, 1e-3, 0.0,
+		     "the range bound beside an edge pixel not subdivided");
+	image_release(&acc);
+}
+
 static void test_pixel_errors_threads(void **state)
 {
 	enum { W = 37, H = 300, N = W * H };
@@ -2262,6 +2348,7 @@ int main(void)
 		cmocka_unit_test(test_plan_pack_ahead),
 		cmocka_unit_test(test_plan_cost_map),
 		cmocka_unit_test(test_pixel_errors),
+		cmocka_unit_test(test_pixel_errors_edges),
 		cmocka_unit_test(test_pixel_errors_threads),
 		cmocka_unit_test(test_final_choice),
 		cmocka_unit_test(test_sparse_error),
