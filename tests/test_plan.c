@@ -385,7 +385,7 @@ static void test_merge_grid(void **state)
  */
 static void test_merge_stratified(void **state)
 {
-	const int W = 5, H = 1;
+	const int W = 9, H = 1;
 	(void)state;
 	for (int kind = 0; kind < 4; kind++) {
 		const int s = kind % 2 ? 2 : 4;
@@ -416,12 +416,53 @@ static void test_merge_stratified(void **state)
 			double iid = d2 * na * nb / (nt * nt), own = d2 * na * na / (nt * nt);
 			char what[64];
 			snprintf(what, sizeof(what), "scale %d onto %g: pixel %d diff", s, na, x);
-			/* the twisted pixel's mean is 0.3 too */
-			assert_close(o[ACC_DIFF], x < W - 2 && na < 2.0 ? own : iid, 1e-4, 0.0, what);
+			/* the twisted pixel's mean is 0.3 too; the pixels whose
+			 * 5 x 5 has no twist (x <= 4) take the lowered diff,
+			 * twenty or four times below the other; onto 4 samples
+			 * every pixel keeps the independent one */
+			if (na >= 2.0)
+				assert_close(o[ACC_DIFF], iid, 1e-4, 0.0, what);
+			else if (x <= 4)
+				assert_close(o[ACC_DIFF], own, 1e-4, 0.0, what);
 		}
 		image_release(&r);
 		image_release(&acc);
 	}
+
+	/* noise: quadrants 0.3 +- t in a twist, the base sample 0.3 + sqrt(3) t,
+	 * so that at scale 2 the two diffs are alike (d2 = 3 vb, 1.5 apart): the mean of
+	 * the two, not the smaller (the smaller of two noisy values is biased
+	 * low) */
+	struct image acc, r;
+	char err[256];
+	long folded = -1;
+	const double t = 0.02, base = 0.3 + sqrt(3.0) * t;
+	make_acc(&acc, 5, 1, flat_value);
+	for (int x = 0; x < 5; x++) {
+		float *o = accpx(&acc, (size_t)x);
+		o[ACC_SAMPLES] = 1.0f;
+		for (int c = 0; c < 3; c++)
+			o[c] = (float)base;
+	}
+	assert_int_equal(image_init(&r, 10, 2, 3, rgb_names, err, sizeof(err)), 0);
+	for (int x = 0; x < 5; x++)
+		for (int j = 0; j < 2; j++)
+			for (int l = 0; l < 2; l++)
+				for (int c = 0; c < 3; c++)
+					r.px[((size_t)j * r.w + 2 * x + l) * 3 + c] =
+						(float)(0.3 + (j == l ? t : -t));
+	assert_int_equal(accum_merge_region(&acc, &r, 0, 2, 0, 0, 4, 0, 1, &folded, err,
+					    sizeof(err)), 0);
+	const double mt = (base + 4.0 * 0.3) / 5.0;
+	const double d2 = (base - 0.3) * (base - 0.3) / (mt * mt + 0.01);
+	const double vb = t * t / (0.3 * 0.3 + 0.01);
+	const double iid = d2 * 4.0 / 25.0, low = (d2 - vb + 16.0 * vb) / 25.0;
+	assert_true(iid < 2.0 * low && low < 2.0 * iid);
+	for (int x = 0; x < 5; x++)
+		assert_close(accpx(&acc, (size_t)x)[ACC_DIFF], 0.5 * (iid + low), 1e-3, 0.0,
+			     "noise: the mean of the two diffs");
+	image_release(&r);
+	image_release(&acc);
 }
 
 /* 2. accum_merge_region: block statistics, untouched outside, errors. */
