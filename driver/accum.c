@@ -434,7 +434,6 @@ struct strat {
 	int x0, y0, rw, rh;
 	double *tw;		/* the twist of the new samples, NaN where none */
 	double *d2, *na, *nb;	/* the fold's difference and counts; nb 0: no fold */
-	double *ind, *lo;	/* the diff as independent samples', and lowered */
 };
 
 static int strat_begin(struct strat *st, int x0, int y0, int x1, int y1)
@@ -444,14 +443,12 @@ static int strat_begin(struct strat *st, int x0, int y0, int x1, int y1)
 	st->rw = x1 - x0 + 1;
 	st->rh = y1 - y0 + 1;
 	const size_t rn = (size_t)st->rw * st->rh;
-	st->tw = malloc(6 * rn * sizeof(*st->tw));
+	st->tw = malloc(4 * rn * sizeof(*st->tw));
 	if (!st->tw)
 		return 0;
 	st->d2 = st->tw + rn;
 	st->na = st->d2 + rn;
 	st->nb = st->na + rn;
-	st->ind = st->nb + rn;
-	st->lo = st->ind + rn;
 	for (size_t k = 0; k < rn; k++) {
 		st->tw[k] = NAN;
 		st->nb[k] = 0.0;
@@ -505,7 +502,10 @@ static void strat_end(struct strat *st, struct image *acc)
 			const size_t k = (size_t)y * st->rw + x;
 			const float *o = acc->px + ((size_t)(st->y0 + y) * acc->w + st->x0 + x) * ACC_NCH;
 			const double na = st->na[k], nb = st->nb[k], d2 = st->d2[k];
-			st->ind[k] = st->lo[k] = NAN;
+			/* from here on na holds the independent samples' diff
+			 * and d2 the lowered one, NaN where there is no choice
+			 * (each read at its own pixel only before) */
+			st->na[k] = st->d2[k] = NAN;
 			if (!isfinite(st->tw[k]) || !(na > 0.0) || na >= STRAT_OLD_MAX || !(nb > 0.0) ||
 			    !isfinite(o[ACC_DIFF]))
 				continue;
@@ -521,20 +521,21 @@ static void strat_end(struct strat *st, struct image *acc)
 			const double vb = sum / n, nt = na + nb;
 			const double st_d = (na * na * (d2 > vb ? d2 - vb : 0.0) + nb * nb * vb) / (nt * nt);
 			if (isfinite(st_d)) {
-				st->ind[k] = o[ACC_DIFF];
-				st->lo[k] = st_d;
+				st->na[k] = o[ACC_DIFF];
+				st->d2[k] = st_d;
 			}
 		}
 	for (int y = 0; y < st->rh; y++)
 		for (int x = 0; x < st->rw; x++) {
 			const size_t k = (size_t)y * st->rw + x;
-			if (!isfinite(st->lo[k]))
+			const double *ind = st->na, *lo = st->d2;
+			if (!isfinite(lo[k]))
 				continue;
-			const double ai = strat_around(st, st->ind, st->lo, x, y),
-				     as = strat_around(st, st->lo, st->ind, x, y);
+			const double ai = strat_around(st, ind, lo, x, y),
+				     as = strat_around(st, lo, ind, x, y);
 			const double big = ai > as ? ai : as, small = ai > as ? as : ai;
-			double d = big > STRAT_APART * small ? (as < ai ? st->lo[k] : st->ind[k])
-							      : 0.5 * (st->ind[k] + st->lo[k]);
+			const double d = big > STRAT_APART * small ? (as < ai ? lo[k] : ind[k])
+								   : 0.5 * (ind[k] + lo[k]);
 			acc->px[((size_t)(st->y0 + y) * acc->w + st->x0 + x) * ACC_NCH + ACC_DIFF] = (float)d;
 		}
 	free(st->tw);
@@ -981,8 +982,9 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 				continue;
 			double dh = d > 0.0 ? sqrt(h2) : -sqrt(h2);
 			/* between two pixels of a render taken for edges, at most
-			 * the threshold, and at most what this pixel's own render
-			 * pixels differ by (ACC_AA_STEP_SD of their spread) */
+			 * the threshold, and at most what this pixel's samples
+			 * spread over (ACC_AA_STEP_SD of their deviation: after
+			 * the render's fold, about its render pixels') */
 			double cap = ACC_AA_THRESHOLD / 3.0;
 			if (seen && own && ACC_AA_STEP_SD * sqrt(o[ACC_VAR_R + c]) < cap)
 				cap = ACC_AA_STEP_SD * sqrt(o[ACC_VAR_R + c]);
@@ -1043,6 +1045,14 @@ static double value_bias(const float *o)
 	return isfinite(m / x) ? m / x : 1.0;
 }
 
+/* Whether POV-Ray subdivided pixel i in a render taken for edges
+ * (ACC_AA_DEEP is scale 8's bit too: a grid render of scale 8 alone sets
+ * it, and its spread is the pixel's noise). */
+static int subdivided(const struct image *acc, size_t i)
+{
+	return accum_has_scale(acc, i, ACC_AA_EDGE) && accum_has_scale(acc, i, ACC_AA_DEEP);
+}
+
 /*
  * The largest relative squared error pixel i's mean can have if its true
  * value lies within the range of the means of its 3x3 neighbourhood (itself
@@ -1052,10 +1062,11 @@ static double value_bias(const float *o)
  * beyond PRESS; the hidden-edge part of the estimate is for those.  A
  * neighbour POV-Ray subdivided for an edge (ACC_AA_DEEP) counts as the
  * nearest value of its mean +- its samples' spread: its mean is a mix of
- * the edge's two sides (still_life at --target 3e-3: the one-sample pixels
- * beside a subdivided row, whose mean the dark side two rows up had
- * lowered by 0.035, were estimated 0.008 each for a true 2e-8, 3.8e-6 of
- * the image's 1.66e-5; now 5e-9).
+ * the edge's two sides (still_life at --target 3e-3: the 42 one-sample
+ * pixels beside a subdivided row, whose mean the dark side two rows up had
+ * lowered by 0.035, were estimated up to 0.008 each by PRESS, the range
+ * bound no lower, for a true 2e-8: 3.8e-6 of the image's 1.66e-5 in all;
+ * now 5e-9).
  */
 static double range_bound(const struct image *acc, size_t i)
 {
@@ -1077,11 +1088,10 @@ static double range_bound(const struct image *acc, size_t i)
 				 * nearest of its mean +- its samples' spread */
 				double ql = q[c], qh = q[c];
 				const size_t qi = (size_t)(q - acc->px) / ACC_NCH;
-				if (q[ACC_SAMPLES] >= 4.0f && accum_has_scale(acc, qi, ACC_AA_DEEP)) {
-					double sd = sqrt(q[ACC_VAR_R + c]);
+				const double sd = sqrt(q[ACC_VAR_R + c]);
+				if (q[ACC_SAMPLES] >= 4.0f && isfinite(sd) && subdivided(acc, qi))
 					ql = qh = o[c] < q[c] - sd ? q[c] - sd
 						  : o[c] > q[c] + sd ? q[c] + sd : o[c];
-				}
 				lo = ql < lo ? ql : lo;
 				hi = qh > hi ? qh : hi;
 			}

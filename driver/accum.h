@@ -126,10 +126,11 @@ static inline int accum_edge_cells(int d)
 #define ACC_AA_THRESHOLD 0.1
 
 /*
- * How many standard deviations of an edge render's pixels (the spread of
- * its render pixels, accum_merge_edge_file()) a step hidden inside it can
- * be: one render pixel of four apart by t gives a spread of t sqrt(3) / 4,
- * t about 2.3 of them.  Their corners on the pixel's border are shared with
+ * How many standard deviations of an edge render's pixel (its samples'
+ * spread; after the render's fold onto the base sample, about its render
+ * pixels', accum_merge_edge_file()) a step hidden inside it can be: one
+ * render pixel of four apart by t gives a sample standard deviation (over
+ * n - 1) of t / 2.  Their corners on the pixel's border are shared with
  * its neighbour, so a step between the two that this pixel's render pixels
  * do not show is on the neighbour's side (still_life at --target 3e-3: 477
  * flat pixels beside a ramp were charged 7e-6 for a true 7.9e-7; 191 of

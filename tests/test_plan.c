@@ -377,11 +377,14 @@ static void test_merge_grid(void **state)
  * base sample at 0.5, pixels whose four sub-pixels agree at 0.3 (no
  * twist: the new mean exact) have the old sample's difference charged at
  * its own weight, d2 / nt^2, not the independent samples' d2 nb / nt^2;
- * a pixel whose sub-pixels twist (0.5 and 0.1 crosswise) keeps the
- * independent figure, and so does its neighbour, whose 3 x 3 mean takes a
- * third of the twist (weighed by nb^2 it outweighs d2).  Grid renders (scale 4, 5 samples a
- * sub-pixel) and resolution scaling (scale 2, one sample a quadrant) alike.
- * Onto 4 samples every pixel keeps the independent figure.
+ * The choice between the two figures is made on their means over the 5 x 5
+ * pixels around: the pixels whose window holds no twist (x <= 4 of 9) take
+ * the lowered one; pixel 5, whose window reaches pixel 7 (its 3 x 3 mean
+ * takes a third of pixel 8's twist, crosswise 0.5 and 0.1, which weighed
+ * by nb^2 outweighs d2), has the two means within a factor 2 at scale 4
+ * and takes the mean of its two figures.  Grid renders (scale 4, 5 samples
+ * a sub-pixel) and resolution scaling (scale 2, one sample a quadrant)
+ * alike.  Onto 4 samples every pixel keeps the independent figure.
  */
 static void test_merge_stratified(void **state)
 {
@@ -424,6 +427,8 @@ static void test_merge_stratified(void **state)
 				assert_close(o[ACC_DIFF], iid, 1e-4, 0.0, what);
 			else if (x <= 4)
 				assert_close(o[ACC_DIFF], own, 1e-4, 0.0, what);
+			else if (x == 5 && s == 4)
+				assert_close(o[ACC_DIFF], 0.5 * (iid + own), 1e-4, 0.0, what);
 		}
 		image_release(&r);
 		image_release(&acc);
@@ -1006,8 +1011,8 @@ static void test_merge_aa_edges(void **state)
 	image_release(&plain);
 
 	/* hidden edges: pixel 0 beside a pixel 0.6 brighter, with 8
-	 * samples each, pixel 0's render pixels apart by 0.02 (a spread
-	 * whose ACC_AA_STEP_SD reaches past the cap); as edge pixels the
+	 * samples each, pixel 0's samples' standard deviation 0.02 (whose
+	 * ACC_AA_STEP_SD reaches past the cap); as edge pixels the
 	 * difference that counts is at most the threshold / 3; and where
 	 * POV-Ray subdivided the neighbour (ACC_AA_DEEP) and not pixel 0, the
 	 * edge is the neighbour's: none is charged to pixel 0 */
@@ -1038,9 +1043,9 @@ static void test_merge_aa_edges(void **state)
 	cap *= 0.5;	/* on this pixel's side: 2 / (2 + 2) */
 	assert_true(e[0] > 10.0 * e[1]);
 	assert_close(e[1], cap, 1e-6, 1e-15, "the hidden edge at most the threshold");
-	/* pixel 0's render pixels alike to 0.005: the step its own render
-	 * pixels could hide, ACC_AA_STEP_SD of that, in place of the cap;
-	 * alike to the last bit: none (the step is the neighbour's) */
+	/* pixel 0's samples' standard deviation 0.005: the step its own
+	 * render pixels could hide, ACC_AA_STEP_SD of that, in place of the
+	 * cap; alike to the last bit: none (the step is the neighbour's) */
 	double small = 0.0, t = ACC_AA_STEP_SD * 0.005;
 	for (int c = 0; c < 3; c++)
 		for (int k = 0; k < 4; k++) {
@@ -1705,9 +1710,10 @@ static double mixed_value(int x, int y, int c)
  * no spread): charged as a hidden edge while the two pixels beside both
  * are flat, not when either holds the step in its samples (a lamp's rim).
  * A one-sample pixel beside a pixel POV-Ray subdivided for an edge (its
- * mean 0.035 below, its samples spread 0.05): its range bound counts the
- * neighbour at the nearest of its mean +- spread, here the pixel's own
- * value; without the subdivision the full 0.035.
+ * mean 0.035 below, its samples' standard deviation 0.05): its range bound
+ * counts the neighbour at the nearest of its mean +- that, here the pixel's
+ * own value; without the subdivision (or with scale 8's bit, which
+ * ACC_AA_DEEP shares, but no edge render) the full 0.035.
  */
 static void test_pixel_errors_edges(void **state)
 {
@@ -1743,6 +1749,14 @@ static void test_pixel_errors_edges(void **state)
 		accpx(&acc, 1)[ACC_VAR_R + c] = 0.01f * 0.01f;
 	assert_true(accum_pixel_error(&acc, 0, 1e-6, fit, accum_pixel_noise(&acc, 0, 0.0)) >
 		    0.5 * flat);
+	/* the rim in the other pixel beside both, (0, 1), the same */
+	for (int c = 0; c < 3; c++) {
+		accpx(&acc, 1)[c] = 0.01f;
+		accpx(&acc, 1)[ACC_VAR_R + c] = 0.0f;
+		accpx(&acc, 3)[c] = 0.3f;
+		accpx(&acc, 3)[ACC_VAR_R + c] = 0.6f * 0.6f / 4.0f;
+	}
+	assert_true(accum_pixel_error(&acc, 0, 1e-6, fit, accum_pixel_noise(&acc, 0, 0.0)) == 0.0);
 	image_release(&acc);
 
 	/* one row: a one-sample pixel (0.41) beside a subdivided one (mean
@@ -1764,6 +1778,11 @@ static void test_pixel_errors_edges(void **state)
 					     1u << ACC_AA_EDGE);
 	assert_close(accum_pixel_error(&acc, 1, 1.0, val, NAN), range, 1e-3, 0.0,
 		     "the range bound beside an edge pixel not subdivided");
+	/* scale 8's bit alone (a grid render, no edge render): its spread is
+	 * noise, and its mean counts as it is */
+	accpx(&acc, 2)[ACC_SCALES] = (float)(1u << 1 | 1u << 2 | 1u << 4 | 1u << 8);
+	assert_close(accum_pixel_error(&acc, 1, 1.0, val, NAN), range, 1e-3, 0.0,
+		     "the range bound beside a pixel of scale 8");
 	image_release(&acc);
 }
 
