@@ -94,6 +94,14 @@ int accum_read(const char *path, struct image *acc, char *err, size_t errlen)
 	return 0;
 }
 
+/* The merged mean's squared error from a fold of nb samples onto na whose
+ * means differ by d2 (relative; see ACC_DIFF in accum.h). */
+static double fold_diff(double d2, double na, double nb)
+{
+	const double nt = na + nb;
+	return d2 * na * nb / (nt * nt);
+}
+
 int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
 	       const double m2[3], int pass)
 {
@@ -116,7 +124,7 @@ int accum_fold(struct image *acc, size_t i, int s, int n, const double mean[3],
 		d2 += d * d / (mt * mt + METRICS_RELMSE_EPS) / 3.0;
 	}
 	if (na > 0)
-		o[ACC_DIFF] = (float)(d2 * na * nb / (nt * nt));
+		o[ACC_DIFF] = (float)fold_diff(d2, na, nb);
 	o[ACC_SAMPLES] = (float)nt;
 	o[ACC_PASS] = (float)pass;
 	return 0;
@@ -474,23 +482,26 @@ static void strat_note(struct strat *st, const struct image *acc, size_t i, int 
 	st->nb[k] = nb;
 }
 
-/* The mean over the 5 x 5 pixels of the region around (x, y) of v where
- * both v and u are finite. */
-static double strat_around(const struct strat *st, const double *v, const double *u, int x, int y)
+/* The means of u and of v over the 5 x 5 pixels of the region around
+ * (x, y) where both are finite, into *mu and *mv (NaN where none is). */
+static void strat_around(const struct strat *st, const double *u, const double *v, int x, int y,
+			 double *mu, double *mv)
 {
-	double sum = 0.0;
+	double su = 0.0, sv = 0.0;
 	int n = 0;
 	for (int j = y - 2; j <= y + 2; j++)
 		for (int l = x - 2; l <= x + 2; l++) {
 			if (j < 0 || j >= st->rh || l < 0 || l >= st->rw)
 				continue;
 			const size_t k = (size_t)j * st->rw + l;
-			if (isfinite(v[k]) && isfinite(u[k])) {
-				sum += v[k];
+			if (isfinite(u[k]) && isfinite(v[k])) {
+				su += u[k];
+				sv += v[k];
 				n++;
 			}
 		}
-	return n ? sum / n : NAN;
+	*mu = n ? su / n : NAN;
+	*mv = n ? sv / n : NAN;
 }
 
 static void strat_end(struct strat *st, struct image *acc)
@@ -525,14 +536,14 @@ static void strat_end(struct strat *st, struct image *acc)
 				st->d2[k] = st_d;
 			}
 		}
+	const double *ind = st->na, *lo = st->d2;
 	for (int y = 0; y < st->rh; y++)
 		for (int x = 0; x < st->rw; x++) {
 			const size_t k = (size_t)y * st->rw + x;
-			const double *ind = st->na, *lo = st->d2;
 			if (!isfinite(lo[k]))
 				continue;
-			const double ai = strat_around(st, ind, lo, x, y),
-				     as = strat_around(st, lo, ind, x, y);
+			double ai, as;
+			strat_around(st, ind, lo, x, y, &ai, &as);
 			const double big = ai > as ? ai : as, small = ai > as ? as : ai;
 			const double d = big > STRAT_APART * small ? (as < ai ? lo[k] : ind[k])
 								   : 0.5 * (ind[k] + lo[k]);
@@ -768,11 +779,11 @@ int accum_split_diff(struct image *acc, const struct image *img, int s, char *er
 	if (s == 1)	/* one sample a pixel: no halves */
 		return 0;
 	/* the halves' counts: (j + k) even, then odd, over the s x s */
-	const double na = (s * s + 1) / 2, nb = s * s / 2, nt = na + nb;
+	const double na = (s * s + 1) / 2, nb = s * s / 2;
 	for (int y = 0; y < acc->h; y++)
 		for (int x = 0; x < acc->w; x++) {
 			float *o = acc->px + ((size_t)y * acc->w + x) * ACC_NCH;
-			if (o[ACC_SAMPLES] != (float)nt)
+			if (o[ACC_SAMPLES] != (float)(na + nb))
 				continue;
 			double sum[2][3] = { { 0.0, 0.0, 0.0 }, { 0.0, 0.0, 0.0 } };
 			int ok = 1;
@@ -789,12 +800,12 @@ int accum_split_diff(struct image *acc, const struct image *img, int s, char *er
 				continue;
 			/* as accum_fold() would have it, the second half folded
 			 * onto the first */
-			double d2 = 0.0;
+			double e2[3];
 			for (int c = 0; c < 3; c++) {
 				const double d = sum[1][c] / nb - sum[0][c] / na;
-				d2 += d * d / ((double)o[c] * o[c] + METRICS_RELMSE_EPS) / 3.0;
+				e2[c] = d * d;
 			}
-			o[ACC_DIFF] = (float)(d2 * na * nb / (nt * nt));
+			o[ACC_DIFF] = (float)fold_diff(rel3(o, e2), na, nb);
 		}
 	return 0;
 }
@@ -943,6 +954,7 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 {
 	const float *o = acc->px + i * ACC_NCH, *nb[8];
 	const int own = o[ACC_SAMPLES] >= 4.0f, nn = neighbours8(acc, i, nb);
+	const int w = acc->w, px = (int)(i % (size_t)w), py = (int)(i / (size_t)w);
 	double best = 0.0;
 	for (int j = 0; j < nn; j++) {
 		const float *q = nb[j];
@@ -967,7 +979,6 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 			continue;
 		/* a diagonal neighbour: the two pixels beside both */
 		const float *side[2] = { NULL, NULL };
-		const int w = acc->w, px = (int)(i % (size_t)w), py = (int)(i / (size_t)w);
 		const int qx = (int)(qi % (size_t)w), qy = (int)(qi / (size_t)w);
 		if (qx != px && qy != py) {
 			side[0] = acc->px + ((size_t)py * w + qx) * ACC_NCH;
