@@ -410,15 +410,15 @@ static double quad_twist(double q[4][3], const double mean[3])
  * where an edge twists the quadrants) and are each about right on noise.
  * Per pixel each is a handful of squared numbers, and the smaller of the
  * two noisy values is biased low: the image mean of that per-pixel minimum
- * was half the true error of the merged means (full frames of the base
- * pass and a scale-4 grid render at 160x120, against the references:
- * soft_shadows 0.56, focal_blur 0.47, glossy_reflection 0.54, media 0.50,
- * thin_geometry 0.67, horizon_texture 0.94, still_life 0.75; independent
- * alone 1.96, 1.04, 1.08, 1.00, 2.57, 1.66, 1.80; lowered alone 1.32,
- * 1.15, 1.08, 1.01, 1.61, 1.75, 3.74).  So the choice is made on their
- * means over the 5 x 5 pixels around: where one is more than STRAT_APART
- * times the other, the smaller one's value, else the mean of the two
- * (0.96, 0.93, 0.96, 0.96, 1.40, 1.43, 1.35).
+ * was half the true error of the merged means (scripts/fold_check.py: full
+ * frames of the base pass and a scale-4 grid render at 160x120, against
+ * the references: soft_shadows 0.51, focal_blur 0.47, glossy_reflection
+ * 0.54, media 0.51, thin_geometry 0.66, horizon_texture 0.94, still_life
+ * 0.75; independent alone 1.82, 1.04, 1.08, 1.01, 2.57, 1.66, 1.80;
+ * lowered alone 1.20, 1.15, 1.08, 1.02, 1.60, 1.74, 3.70).  So the choice
+ * is made on their means over the 5 x 5 pixels around: where one is more
+ * than STRAT_APART times the other, the smaller one's value, else the mean
+ * of the two (0.89, 0.93, 0.96, 0.98, 1.39, 1.43, 1.35).
  *
  * Only onto fewer than STRAT_OLD_MAX samples: onto more, stratified
  * themselves, d2 is no longer mostly the old mean's, and the twist of the
