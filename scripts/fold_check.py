@@ -9,16 +9,26 @@ figures of strat_end()), and each figure's image mean over the true relMSE of
 the merged means against make sweep's cached reference (scale 15, jittered):
 
   min     the per-pixel smaller of the two (the rule before 20c41ad)
-  ind     the independent samples' figure alone
+  ind     the independent samples' figure alone (the rule onto 5 samples
+          before 2026-12-03 evening)
   low     the lowered (stratified) figure alone
   5x5     strat_end()'s rule: chosen on the two's 5 x 5 means, the smaller
           one's value where one is more than APART times the other, else the
           mean of the two (APART 2, and 1.5 and 3 beside it)
 
-usage: scripts/fold_check.py [--scale 4|2] [--size WxH] SCENE.pov ...
+usage: scripts/fold_check.py [--scale 4|2] [--onto 1|5] [--scaling] [--size WxH]
+                             SCENE.pov ...
   --scale 4: a grid render (+AM1 +A0.0 +R2 +J0.75 at twice the size, 20
              samples a pixel; the default); --scale 2: resolution scaling
              (twice the size without antialiasing, 4 samples a pixel)
+  --onto 5:  (scale 4) fold onto the base pass and scale 2's four samples (a
+             render at twice the size without antialiasing), as after a
+             scale-2 pass: the grid render's centres, which repeat scale 2's,
+             taken out, 16 new samples onto 5 (default --onto 1: onto the
+             base pass's one)
+  --scaling: (scale 4) the render by resolution scaling (four times the size
+             without antialiasing, 16 samples a pixel) instead of a grid
+             render, as `--sampler auto` renders scale 4 at 160x120
 
 Needs Debian's python3-numpy and python3-openimageio, and POV-Ray.  The renders
 go to a temporary directory; POV-Ray runs from an argument vector.
@@ -66,24 +76,42 @@ def rel(e2, m):
     return (e2 / (m * m + EPS)).mean(axis=2)
 
 
-def check(scene, w, h, scale, tmp):
+def quadrants(a, h, w):
+    q = a.reshape(h, 2, w, 2, 3)
+    return q[:, 0, :, 0], q[:, 0, :, 1], q[:, 1, :, 0], q[:, 1, :, 1]
+
+
+def check(scene, w, h, scale, onto, scaling, tmp):
     name = os.path.splitext(os.path.basename(scene))[0]
     cache = os.environ.get("POVPRESS_CACHE", os.path.expanduser("~/.cache/povpress"))
     refs = sorted(glob.glob("%s/ref/%s-%dx%d-j15-*.exr" % (cache, name, w, h)))
     if not refs:
         die("no reference for %s at %dx%d (make sweep makes them)" % (name, w, h))
     ref = read_rgb(refs[0])
-    base, reg = os.path.join(tmp, "b.exr"), os.path.join(tmp, "r.exr")
+    base, reg, two = (os.path.join(tmp, f) for f in ("b.exr", "r.exr", "s2.exr"))
     povray(scene, w, h, ["-A"], base)
-    if scale == 4:
+    b = read_rgb(base)
+    if scale == 4 and scaling:
+        povray(scene, 4 * w, 4 * h, ["-A"], reg)
+        g = read_rgb(reg).reshape(2 * h, 2, 2 * w, 2, 3).mean(axis=(1, 3))
+        nb = 16.0
+    elif scale == 4:
         povray(scene, 2 * w, 2 * h, ["+AM1", "+A0.0", "+R2", "+J0.75"], reg)
-        na, nb = 1.0, 20.0
+        g = read_rgb(reg)
+        nb = 20.0
     else:
         povray(scene, 2 * w, 2 * h, ["-A"], reg)
-        na, nb = 1.0, 4.0
-    b, g = read_rgb(base), read_rgb(reg)
-    q = g.reshape(h, 2, w, 2, 3)
-    q0, q1, q2, q3 = q[:, 0, :, 0], q[:, 0, :, 1], q[:, 1, :, 0], q[:, 1, :, 1]
+        g = read_rgb(reg)
+        nb = 4.0
+    na = 1.0
+    if onto == 5:
+        povray(scene, 2 * w, 2 * h, ["-A"], two)
+        c = read_rgb(two)
+        b = (b + sum(quadrants(c, h, w))) / 5.0
+        na = 5.0
+        if not scaling:	# a render pixel's centre is scale 2's sample
+            g, nb = (5.0 * g - c) / 4.0, 16.0
+    q0, q1, q2, q3 = quadrants(g, h, w)
     m = (q0 + q1 + q2 + q3) / 4.0
     nt = na + nb
     merged = (na * b + nb * m) / nt
@@ -99,15 +127,19 @@ def check(scene, w, h, scale, tmp):
         chosen = np.where(np.maximum(ai, al) > apart * np.minimum(ai, al), small,
                           0.5 * (ind + low))
         row.append(chosen.mean())
-    print("%-20s %10.3g " % (name, true) + " ".join("%7.2f" % (x / true) for x in row))
+    print("%-28s %10.3g " % (name, true) + " ".join("%7.2f" % (x / true) for x in row))
 
 
 def main(argv):
-    scale, w, h, scenes = 4, 160, 120, []
+    scale, onto, scaling, w, h, scenes = 4, 1, False, 160, 120, []
     it = iter(argv)
     for a in it:
         if a == "--scale":
             scale = int(next(it, "0"))
+        elif a == "--onto":
+            onto = int(next(it, "0"))
+        elif a == "--scaling":
+            scaling = True
         elif a == "--size":
             try:
                 w, h = (int(x) for x in next(it, "").split("x"))
@@ -120,16 +152,20 @@ def main(argv):
             die("unknown option '%s'" % a)
         else:
             scenes.append(a)
-    if scale not in (2, 4) or not scenes:
-        die("usage: scripts/fold_check.py [--scale 4|2] [--size WxH] SCENE.pov ...")
+    if scale not in (2, 4) or onto not in (1, 5) or not scenes:
+        die("usage: scripts/fold_check.py [--scale 4|2] [--onto 1|5] [--scaling] "
+            "[--size WxH] SCENE.pov ...")
+    if scale == 2 and (onto == 5 or scaling):
+        die("--onto 5 and --scaling are for scale 4")
     for s in scenes:
         if not os.path.isfile(s):
             die("no scene '%s'" % s)
-    print("%-20s %10s %7s %7s %7s %7s %7s %7s" %
-          ("scene (scale %d)" % scale, "true", "min", "ind", "low", "5x5", "5x5/1.5", "5x5/3"))
+    print("%-28s %10s %7s %7s %7s %7s %7s %7s" %
+          ("scene (scale %d%s, onto %d)" % (scale, " scaling" if scaling else "", onto),
+           "true", "min", "ind", "low", "5x5", "5x5/1.5", "5x5/3"))
     with tempfile.TemporaryDirectory(prefix="fold_check.") as tmp:
         for s in scenes:
-            check(s, w, h, scale, tmp)
+            check(s, w, h, scale, onto, scaling, tmp)
     return 0
 
 

@@ -390,11 +390,13 @@ static void test_merge_stratified(void **state)
 {
 	const int W = 9, H = 1;
 	(void)state;
-	for (int kind = 0; kind < 4; kind++) {
+	for (int kind = 0; kind < 6; kind++) {
 		const int s = kind % 2 ? 2 : 4;
-		/* kinds 2 and 3: onto 4 samples, where the difference is no
-		 * longer mostly the old mean's */
-		const double nb = kind % 2 ? 4.0 : 20.0, na = kind < 2 ? 1.0 : 4.0, nt = nb + na;
+		/* kinds 2 and 3: onto 5 samples (the base pass's and scale
+		 * 2's), still mostly the old mean's difference; kinds 4 and
+		 * 5: onto 21, where it no longer is */
+		const double nb = kind % 2 ? 4.0 : 20.0, na = kind < 2 ? 1.0 : kind < 4 ? 5.0 : 21.0;
+		const double nt = nb + na;
 		struct image acc, r;
 		char err[256];
 		long folded = -1;
@@ -420,14 +422,18 @@ static void test_merge_stratified(void **state)
 			char what[64];
 			snprintf(what, sizeof(what), "scale %d onto %g: pixel %d diff", s, na, x);
 			/* the twisted pixel's mean is 0.3 too; the pixels whose
-			 * 5 x 5 has no twist (x <= 4) take the lowered diff,
-			 * twenty or four times below the other; onto 4 samples
-			 * every pixel keeps the independent one */
-			if (na >= 2.0)
+			 * 5 x 5 has no twist (x <= 4) take the lowered diff
+			 * where it is nb / na times below the other, more than
+			 * twice (twenty and four times onto 1, four times
+			 * scale 4's onto 5), and the mean of the two where not
+			 * (scale 2's 4 onto 5); onto 21 every pixel keeps the
+			 * independent one */
+			if (na > 6.0)
 				assert_close(o[ACC_DIFF], iid, 1e-4, 0.0, what);
 			else if (x <= 4)
-				assert_close(o[ACC_DIFF], own, 1e-4, 0.0, what);
-			else if (x == 5 && s == 4)
+				assert_close(o[ACC_DIFF], nb > 2.0 * na ? own : 0.5 * (iid + own),
+					     1e-4, 0.0, what);
+			else if (x == 5 && s == 4 && na < 2.0)
 				assert_close(o[ACC_DIFF], 0.5 * (iid + own), 1e-4, 0.0, what);
 		}
 		image_release(&r);
