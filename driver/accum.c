@@ -420,37 +420,45 @@ static double quad_twist(double q[4][3], const double mean[3])
  * than STRAT_APART times the other, the smaller one's value, else the mean
  * of the two (0.89, 0.93, 0.96, 0.98, 1.39, 1.43, 1.35).
  *
- * Only onto fewer than STRAT_OLD_MAX samples: the base pass's one, or that
- * and scale 2's four at fixed positions (a scale-4 render after a scale-2
- * pass).  Onto 5, whole frames of the base pass and scale 2 with a scale-4
- * render by resolution scaling (scripts/fold_check.py --onto 5 --scaling)
- * gave the independent figure at 1.07 to 6.20 of the truth on seven scenes
+ * Only onto the base pass's one sample (fewer than 4: the base pass's, or
+ * scale 2's with some missing), or onto 5, that and scale 2's four at fixed
+ * positions (a scale-4 render after a scale-2 pass): strat_onto().  Onto 5,
+ * whole frames of the base pass and scale 2 with a scale-4 render by
+ * resolution scaling (scripts/fold_check.py --onto 5 --scaling) gave the
+ * independent figure at 0.99 to 6.20 of the truth on seven scenes
  * (soft_shadows 6.20, horizon_texture 2.23, still_life 1.77,
  * thin_geometry 1.47) and 0.57 to 0.79 on starfield and hdr_highlights;
- * the rule 0.86 to 2.41, and 0.52 and 0.66.  Onto more, stratified
- * themselves at jittered positions, d2 is no longer mostly the old mean's,
- * and the twist of the new samples' quadrants understates their error
- * where the sub-pixels of one render share a pattern (POV-Ray's area-light
- * and blur sampling), so the lowered diff put the estimate of long runs at
- * a third to a half of the truth.  At 160x120, every fold lowered against
- * only those onto the base pass's sample (2026-12-01, the smaller of the
- * two figures then, one run each, estimated over true relMSE):
- * soft_shadows --budget 4 0.47 against 1.20, thin_geometry --target 3e-4
- * 0.53 against 0.74, --budget 4 0.59 against 0.74, starfield --target
- * 3e-4 0.83 against 1.00, glossy_reflection --target 3e-4 0.66 against
- * 0.86 (README).
+ * the rule 0.86 to 2.41, and 0.52 and 0.66.  Onto 4 (a radiosity pass at
+ * scale 2, whose samples share the solution of every later render, so
+ * that their fold difference already reads low) and onto 6 or more,
+ * stratified themselves at jittered positions, not: there d2 is no longer
+ * mostly the old mean's, and the twist of the new samples' quadrants
+ * understates their error where the sub-pixels of one render share a
+ * pattern (POV-Ray's area-light and blur sampling), so the lowered diff
+ * put the estimate of long runs at a third to a half of the truth.  At
+ * 160x120, every fold lowered against only those onto the base pass's
+ * sample (2026-12-01, the smaller of the two figures then, one run each,
+ * estimated over true relMSE): soft_shadows --budget 4 0.47 against 1.20,
+ * thin_geometry --target 3e-4 0.53 against 0.74, --budget 4 0.59 against
+ * 0.74, starfield --target 3e-4 0.83 against 1.00, glossy_reflection
+ * --target 3e-4 0.66 against 0.86 (README).
  *
  * A region's merge notes each pixel it folds (strat_note()), and once all
  * have folded strat_end() sets their diffs.  Without the memory
  * (strat_begin() returns 0) the diffs stay the independent samples'.
  */
-#define STRAT_OLD_MAX 6.0
 #define STRAT_APART 2.0
 struct strat {
 	int x0, y0, rw, rh;
 	double *tw;		/* the twist of the new samples, NaN where none */
 	double *d2, *na, *nb;	/* the fold's difference and counts; nb 0: no fold */
 };
+
+/* Whether a fold onto na samples gets the choice (above). */
+static int strat_onto(double na)
+{
+	return na > 0.0 && (na < 4.0 || na == 5.0);
+}
 
 static int strat_begin(struct strat *st, int x0, int y0, int x1, int y1)
 {
@@ -525,7 +533,7 @@ static void strat_end(struct strat *st, struct image *acc)
 			 * and d2 the lowered one, NaN where there is no choice
 			 * (each read at its own pixel only before) */
 			st->na[k] = st->d2[k] = NAN;
-			if (!isfinite(st->tw[k]) || !(na > 0.0) || na >= STRAT_OLD_MAX || !(nb > 0.0) ||
+			if (!isfinite(st->tw[k]) || !strat_onto(na) || !(nb > 0.0) ||
 			    !isfinite(o[ACC_DIFF]))
 				continue;
 			double sum = 0.0;

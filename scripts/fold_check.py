@@ -2,8 +2,9 @@
 """fold_check.py - how well the fold difference of a stratified region render
 estimates the error of the merged means, on whole frames.
 
-For each scene: the base pass (one sample a pixel) and one region render over
-the whole frame, folded as driver/accum.c folds them (the fold difference d2,
+For each scene: the base pass (one sample a pixel; with --onto 5 that and
+scale 2's four) and one region render over the whole frame, folded as
+driver/accum.c folds them (the fold difference d2,
 the quadrants' twist averaged over 3 x 3, the independent and the lowered
 figures of strat_end()), and each figure's image mean over the true relMSE of
 the merged means against make sweep's cached reference (scale 15, jittered):
@@ -109,8 +110,9 @@ def check(scene, w, h, scale, onto, scaling, tmp):
         c = read_rgb(two)
         b = (b + sum(quadrants(c, h, w))) / 5.0
         na = 5.0
-        if not scaling:	# a render pixel's centre is scale 2's sample
-            g, nb = (5.0 * g - c) / 4.0, 16.0
+        if not scaling:	# a render pixel's centre repeats scale 2's sample:
+            # taken out as the merge does (grid_pixel()), by the old mean
+            g, nb = (5.0 * g - np.repeat(np.repeat(b, 2, axis=0), 2, axis=1)) / 4.0, 16.0
     q0, q1, q2, q3 = quadrants(g, h, w)
     m = (q0 + q1 + q2 + q3) / 4.0
     nt = na + nb
@@ -135,9 +137,15 @@ def main(argv):
     it = iter(argv)
     for a in it:
         if a == "--scale":
-            scale = int(next(it, "0"))
+            try:
+                scale = int(next(it, "0"))
+            except ValueError:
+                die("--scale takes 4 or 2")
         elif a == "--onto":
-            onto = int(next(it, "0"))
+            try:
+                onto = int(next(it, "0"))
+            except ValueError:
+                die("--onto takes 1 or 5")
         elif a == "--scaling":
             scaling = True
         elif a == "--size":

@@ -384,19 +384,21 @@ static void test_merge_grid(void **state)
  * by nb^2 outweighs d2), has the two means within a factor 2 at scale 4
  * and takes the mean of its two figures.  Grid renders (scale 4, 5 samples
  * a sub-pixel) and resolution scaling (scale 2, one sample a quadrant)
- * alike.  Onto 4 samples every pixel keeps the independent figure.
+ * alike.  Onto 5 samples (the base pass's and scale 2's) the same, where
+ * the lowered figure is more than twice below; onto 4 (a radiosity pass at
+ * scale 2) and onto 21 every pixel keeps the independent figure.
  */
 static void test_merge_stratified(void **state)
 {
 	const int W = 9, H = 1;
 	(void)state;
-	for (int kind = 0; kind < 6; kind++) {
+	static const double onto[4] = { 1.0, 5.0, 4.0, 21.0 };
+	for (int kind = 0; kind < 8; kind++) {
 		const int s = kind % 2 ? 2 : 4;
 		/* kinds 2 and 3: onto 5 samples (the base pass's and scale
-		 * 2's), still mostly the old mean's difference; kinds 4 and
-		 * 5: onto 21, where it no longer is */
-		const double nb = kind % 2 ? 4.0 : 20.0, na = kind < 2 ? 1.0 : kind < 4 ? 5.0 : 21.0;
-		const double nt = nb + na;
+		 * 2's), still mostly the old mean's difference; 4 and 5: onto
+		 * a radiosity pass's 4; 6 and 7: onto 21, where it no longer is */
+		const double nb = kind % 2 ? 4.0 : 20.0, na = onto[kind / 2], nt = nb + na;
 		struct image acc, r;
 		char err[256];
 		long folded = -1;
@@ -426,9 +428,9 @@ static void test_merge_stratified(void **state)
 			 * where it is nb / na times below the other, more than
 			 * twice (twenty and four times onto 1, four times
 			 * scale 4's onto 5), and the mean of the two where not
-			 * (scale 2's 4 onto 5); onto 21 every pixel keeps the
-			 * independent one */
-			if (na > 6.0)
+			 * (scale 2's 4 onto 5); onto 4 and 21 every pixel
+			 * keeps the independent one */
+			if (na == 4.0 || na > 6.0)
 				assert_close(o[ACC_DIFF], iid, 1e-4, 0.0, what);
 			else if (x <= 4)
 				assert_close(o[ACC_DIFF], nb > 2.0 * na ? own : 0.5 * (iid + own),
