@@ -452,6 +452,7 @@ struct strat {
 	int x0, y0, rw, rh;
 	double *tw;		/* the twist of the new samples, NaN where none */
 	double *d2, *na, *nb;	/* the fold's difference and counts; nb 0: no fold */
+	double *ind, *lo;	/* the two figures, NaN where there is no choice */
 };
 
 /* Whether a fold onto na samples gets the choice (above). */
@@ -467,14 +468,16 @@ static int strat_begin(struct strat *st, int x0, int y0, int x1, int y1)
 	st->rw = x1 - x0 + 1;
 	st->rh = y1 - y0 + 1;
 	const size_t rn = (size_t)st->rw * st->rh;
-	st->tw = malloc(4 * rn * sizeof(*st->tw));
+	st->tw = malloc(6 * rn * sizeof(*st->tw));
 	if (!st->tw)
 		return 0;
 	st->d2 = st->tw + rn;
 	st->na = st->d2 + rn;
 	st->nb = st->na + rn;
+	st->ind = st->nb + rn;
+	st->lo = st->ind + rn;
 	for (size_t k = 0; k < rn; k++) {
-		st->tw[k] = NAN;
+		st->tw[k] = st->ind[k] = st->lo[k] = NAN;
 		st->nb[k] = 0.0;
 	}
 	return 1;
@@ -529,10 +532,6 @@ static void strat_end(struct strat *st, struct image *acc)
 			const size_t k = (size_t)y * st->rw + x;
 			const float *o = acc->px + ((size_t)(st->y0 + y) * acc->w + st->x0 + x) * ACC_NCH;
 			const double na = st->na[k], nb = st->nb[k], d2 = st->d2[k];
-			/* from here on na holds the independent samples' diff
-			 * and d2 the lowered one, NaN where there is no choice
-			 * (each read at its own pixel only before) */
-			st->na[k] = st->d2[k] = NAN;
 			if (!isfinite(st->tw[k]) || !strat_onto(na) || !(nb > 0.0) ||
 			    !isfinite(o[ACC_DIFF]))
 				continue;
@@ -548,11 +547,11 @@ static void strat_end(struct strat *st, struct image *acc)
 			const double vb = sum / n, nt = na + nb;
 			const double st_d = (na * na * (d2 > vb ? d2 - vb : 0.0) + nb * nb * vb) / (nt * nt);
 			if (isfinite(st_d)) {
-				st->na[k] = o[ACC_DIFF];
-				st->d2[k] = st_d;
+				st->ind[k] = o[ACC_DIFF];
+				st->lo[k] = st_d;
 			}
 		}
-	const double *ind = st->na, *lo = st->d2;
+	const double *ind = st->ind, *lo = st->lo;
 	for (int y = 0; y < st->rh; y++)
 		for (int x = 0; x < st->rw; x++) {
 			const size_t k = (size_t)y * st->rw + x;
@@ -1099,32 +1098,36 @@ static double range_bound(const struct image *acc, size_t i)
 {
 	const int w = acc->w, h = acc->h, x = (int)(i % (size_t)w), y = (int)(i / (size_t)w);
 	const float *o = acc->px + i * ACC_NCH;
+	double lo[3] = { o[0], o[1], o[2] }, hi[3] = { o[0], o[1], o[2] };
+	for (int dy = -1; dy <= 1; dy++)
+		for (int dx = -1; dx <= 1; dx++) {
+			if (x + dx < 0 || x + dx >= w || y + dy < 0 || y + dy >= h)
+				continue;
+			const size_t qi = (size_t)(y + dy) * w + (x + dx);
+			const float *q = acc->px + qi * ACC_NCH;
+			if (!(q[ACC_SAMPLES] > 0.0f))
+				continue;
+			/* a neighbour POV-Ray subdivided for an edge: its mean
+			 * mixes the edge's two sides, and the values beside this
+			 * pixel are among its samples: the nearest of its mean
+			 * +- its samples' spread */
+			const int mixed = q[ACC_SAMPLES] >= 4.0f && subdivided(acc, qi);
+			for (int c = 0; c < 3; c++) {
+				if (!isfinite(q[c]))
+					continue;
+				double v = q[c];
+				const double sd = sqrt(q[ACC_VAR_R + c]);
+				if (mixed && isfinite(sd))
+					v = o[c] < v - sd ? v - sd : o[c] > v + sd ? v + sd : o[c];
+				lo[c] = v < lo[c] ? v : lo[c];
+				hi[c] = v > hi[c] ? v : hi[c];
+			}
+		}
 	double b = 0.0;
 	for (int c = 0; c < 3; c++) {
-		double lo = o[c], hi = o[c];
-		for (int dy = -1; dy <= 1; dy++)
-			for (int dx = -1; dx <= 1; dx++) {
-				if (x + dx < 0 || x + dx >= w || y + dy < 0 || y + dy >= h)
-					continue;
-				const float *q = acc->px + ((size_t)(y + dy) * w + (x + dx)) * ACC_NCH;
-				if (!(q[ACC_SAMPLES] > 0.0f) || !isfinite(q[c]))
-					continue;
-				/* a neighbour POV-Ray subdivided for an edge: its
-				 * mean mixes the edge's two sides, and the values
-				 * beside this pixel are among its samples: the
-				 * nearest of its mean +- its samples' spread */
-				double ql = q[c], qh = q[c];
-				const size_t qi = (size_t)(q - acc->px) / ACC_NCH;
-				const double sd = sqrt(q[ACC_VAR_R + c]);
-				if (q[ACC_SAMPLES] >= 4.0f && isfinite(sd) && subdivided(acc, qi))
-					ql = qh = o[c] < q[c] - sd ? q[c] - sd
-						  : o[c] > q[c] + sd ? q[c] + sd : o[c];
-				lo = ql < lo ? ql : lo;
-				hi = qh > hi ? qh : hi;
-			}
-		double dl = o[c] - lo, dh = hi - o[c];
-		double fl = dl * dl / (lo * lo + METRICS_RELMSE_EPS),
-		       fh = dh * dh / (hi * hi + METRICS_RELMSE_EPS);
+		const double dl = o[c] - lo[c], dh = hi[c] - o[c];
+		const double fl = dl * dl / (lo[c] * lo[c] + METRICS_RELMSE_EPS),
+			     fh = dh * dh / (hi[c] * hi[c] + METRICS_RELMSE_EPS);
 		b += (fl > fh ? fl : fh) / 3.0;
 	}
 	return isfinite(b) ? b : 1.0;

@@ -914,6 +914,20 @@ static void test_merge_aa(void **state)
 /* The cells an edge render's spread is divided over (ACC_AA_EDGE), as the
  * header gives them: 1 up to a tenth of the threshold, `cells` from it,
  * geometric between. */
+/* The hidden-edge term of a pixel of value v whose neighbour differs by d
+ * (grey, no spread), its finest scale s, before the share: the mean of
+ * (alpha d)^2 / ((v + alpha d)^2 + 0.01) over alpha in [0, 1/(2s)], by the
+ * midpoint rule on 4 points. */
+static double edge_strip(double v, double d, int s)
+{
+	double e = 0.0;
+	for (int k = 0; k < 4; k++) {
+		double m = (k + 0.5) / (8.0 * s) * d;
+		e += m * m / ((v + m) * (v + m) + 0.01) / 4.0;
+	}
+	return e;
+}
+
 static double edge_cells_want(double range, double cells)
 {
 	if (range <= ACC_AA_THRESHOLD / 10.0)
@@ -1042,24 +1056,15 @@ static void test_merge_aa_edges(void **state)
 		e[k] = accum_pixel_error(&two, 0, NAN, NULL, 0.0);
 	}
 	assert_true(e[2] == 0.0);
-	double cap = 0.0;	/* hidden_edge()'s sum with |d| at the cap, scale 2 */
-	for (int c = 0; c < 3; c++)
-		for (int k = 0; k < 4; k++) {
-			double m = (k + 0.5) / 16.0 * (ACC_AA_THRESHOLD / 3.0);
-			cap += m * m / ((0.2 + m) * (0.2 + m) + METRICS_RELMSE_EPS) / 12.0;
-		}
-	cap *= 0.5;	/* on this pixel's side: 2 / (2 + 2) */
+	/* hidden_edge()'s term with |d| at the cap, scale 2, on this pixel's
+	 * side: 2 / (2 + 2) */
+	const double cap = 0.5 * edge_strip(0.2, ACC_AA_THRESHOLD / 3.0, 2);
 	assert_true(e[0] > 10.0 * e[1]);
 	assert_close(e[1], cap, 1e-6, 1e-15, "the hidden edge at most the threshold");
 	/* pixel 0's samples' standard deviation 0.005: the step its own
 	 * render pixels could hide, ACC_AA_STEP_SD of that, in place of the
 	 * cap; alike to the last bit: none (the step is the neighbour's) */
-	double small = 0.0, t = ACC_AA_STEP_SD * 0.005;
-	for (int c = 0; c < 3; c++)
-		for (int k = 0; k < 4; k++) {
-			double m = (k + 0.5) / 16.0 * t;
-			small += 0.5 * m * m / ((0.2 + m) * (0.2 + m) + METRICS_RELMSE_EPS) / 12.0;
-		}
+	const double small = 0.5 * edge_strip(0.2, ACC_AA_STEP_SD * 0.005, 2);
 	for (int c = 0; c < 3; c++)
 		accpx(&two, 0)[ACC_VAR_R + c] = 0.005f * 0.005f;
 	accpx(&two, 1)[ACC_SCALES] = accpx(&two, 0)[ACC_SCALES];
@@ -1826,20 +1831,6 @@ static void test_pixel_errors_threads(void **state)
 
 /* 6b. A pixel's error estimate: fold differences averaged over neighbours
  * of like sample variance, relative to an estimate of the true value. */
-/* The hidden-edge term of a pixel of value v whose neighbour differs by d
- * (grey, no spread), its finest scale s, before the share: the mean of
- * (alpha d)^2 / ((v + alpha d)^2 + 0.01) over alpha in [0, 1/(2s)], by the
- * midpoint rule on 4 points. */
-static double edge_strip(double v, double d, int s)
-{
-	double e = 0.0;
-	for (int k = 0; k < 4; k++) {
-		double m = (k + 0.5) / (8.0 * s) * d;
-		e += m * m / ((v + m) * (v + m) + 0.01) / 4.0;
-	}
-	return e;
-}
-
 static void test_pixel_errors(void **state)
 {
 	enum { N = 7 };
