@@ -33,7 +33,11 @@
 # in ${POVPRESS_CACHE:-$HOME/.cache/povpress}/ref/ as
 # SCENE-WxH-jS-KEY.exr, KEY a hash of the scene file's contents, the size,
 # the scale, the settings and POV-Ray's version: editing a scene makes a new
-# reference.  (The hash does not cover files the scene includes.)
+# reference.  (The hash does not cover files the scene includes.)  A scene
+# whose file sets assumed_gamma other than 1 is rendered at 3 s times the
+# size without antialiasing instead, box-averaged (9 s^2 samples per pixel on
+# a regular grid): POV-Ray's antialiasing averages in that gamma's encoding,
+# and the reference is the linear average (REF_SETTINGS_GAMMA below).
 #
 # Runs, one at a time, so that CPU times are comparable:
 #   noaa      no antialiasing (-A)
@@ -180,7 +184,7 @@ check_path() {
 		die "cannot pass '$1' to povray: the path has a double quote or a byte outside printable ASCII"
 }
 names=()
-declare -A seen_name=()
+declare -A seen_name=() GAMMA=()
 for i in "${!scenes[@]}"; do
 	sc=${scenes[$i]}
 	[[ -f $sc && -r $sc ]] || die "cannot read scene '$sc'"
@@ -202,6 +206,61 @@ REF_R=3
 REF_AA=(+AM1 +A0.0 "+R$REF_R" +J1.0)
 REF_SPP=$((REF_R * REF_R + 1))
 REF_SETTINGS="povray -D -GA +FE +WT1 ${REF_AA[*]} at scale s, box-averaged by boxdown"
+# A scene whose file sets assumed_gamma other than 1 gets its references by
+# resolution scaling alone: POV-Ray's antialiasing averages its samples in
+# that gamma's encoding, and the linear box average of the samples is what
+# the reference stands for (and what povpress render's scale renders, and
+# boxdown, compute).  Debian's advanced/isocacti (assumed_gamma 1.3) at
+# 80x60: the antialiased references at scales 9 and 5 were 2.4e-3 and
+# 4.9e-3 from the frame at scale 27 without antialiasing, box-averaged,
+# where ref9 and ref5 were 1.4e-3 apart.  There each reference pixel
+# becomes REF_R x REF_R pixels: the scene at REF_R s times the size, -A,
+# box-averaged by REF_R s, REF_R^2 s^2 samples a pixel on a regular grid.
+# A regular grid quantizes a straight edge along its rows (Debian's
+# lights/shadows' horizon row read 0.372 at scale 9 where the truth is
+# between 0.355 and 0.372: README), on that scene a smaller error than the
+# gamma's over the frame was on isocacti, and POV-Ray has no jittered
+# samples without antialiasing.
+REF_SETTINGS_GAMMA="povray -D -GA +FE +WT1 -A at scale $REF_R s, box-averaged by boxdown"
+
+# scene_gamma SCENE: the assumed_gamma the scene file (not what it includes)
+# gives as a number other than 1, outside comments and strings (the last
+# one given as a number), as povpress render reads it; nothing where it
+# gives none, 1, or an expression.
+scene_gamma() {
+	LC_ALL=C awk 'BEGIN { RS = "\001" }
+	function wordch(c) { return c ~ /[A-Za-z0-9_]/ }
+	{
+		t = t $0
+	}
+	END {
+		n = length(t); g = ""
+		for (i = 1; i <= n; i++) {
+			c2 = substr(t, i, 2)
+			if (c2 == "//") {
+				j = index(substr(t, i), "\n")
+				if (!j) break
+				i += j - 2
+			} else if (c2 == "/*") {
+				j = index(substr(t, i + 2), "*/")
+				if (!j) break
+				i += j + 2
+			} else if (substr(t, i, 1) == "\"") {
+				j = match(substr(t, i + 1), /["\n]/)
+				if (!j) break
+				i += j
+			} else if (substr(t, i, 13) == "assumed_gamma" &&
+				   !(i > 1 && wordch(substr(t, i - 1, 1))) && !wordch(substr(t, i + 13, 1))) {
+				if (match(substr(t, i + 13), /^[ \t\r\n]*[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?/))
+					g = substr(t, i + 13, RLENGTH) + 0
+				i += 12
+			}
+		}
+		if (g != "" && g > 0 && (g - 1 > 0.01 || 1 - g > 0.01))
+			print g
+	}' "$1"
+}
+for sc in "${scenes[@]}"; do GAMMA[$sc]=$(scene_gamma "$sc"); done
 
 mkdir -p "$CACHE" "$OUT"
 OUT=$(cd "$OUT" && pwd)
@@ -304,12 +363,13 @@ timed_povpress() {
 # ---- references
 
 ref_path() { # SCENE S: the cache file of the scene's reference at scale S
-	local key
+	local key settings=$REF_SETTINGS
+	[[ -z ${GAMMA[$1]:-} ]] || settings=$REF_SETTINGS_GAMMA
 	key=$({
 		echo "povpress sweep reference 1"
 		echo "size ${W}x$H"
 		echo "scale $2"
-		echo "settings $REF_SETTINGS"
+		echo "settings $settings"
 		echo "version $POV_VERSION"
 		sha256sum <"$1"
 	} | sha256sum | cut -c1-16)
@@ -317,15 +377,16 @@ ref_path() { # SCENE S: the cache file of the scene's reference at scale S
 }
 
 ref_job() { # SCENE S DEST: render the reference into DEST (runs inside a job)
-	local scene=$1 s=$2 dest=$3 tmp
+	local scene=$1 s=$2 dest=$3 tmp k=$2 aa=("${REF_AA[@]}")
+	[[ -z ${GAMMA[$1]:-} ]] || { k=$((REF_R * s)) aa=(-A); }
 	tmp=$(mktemp -d "$RUNTMP/ref.XXXXXX")
-	pov_args $((s * W)) $((s * H)) "$tmp/hi.exr" "$scene"
-	if ! timed_povray "$tmp/time" "$tmp/log" "${POV[@]}" "${REF_AA[@]}"; then
-		echo "sweep: povray failed on '$scene' at scale $s:" >&2
+	pov_args $((k * W)) $((k * H)) "$tmp/hi.exr" "$scene"
+	if ! timed_povray "$tmp/time" "$tmp/log" "${POV[@]}" "${aa[@]}"; then
+		echo "sweep: povray failed on '$scene' at scale $k:" >&2
 		tail -n 15 "$tmp/log" >&2
 		return 1
 	fi
-	"$BOXDOWN" "$tmp/hi.exr" "$s" "$tmp/ref.exr" || return 1
+	"$BOXDOWN" "$tmp/hi.exr" "$k" "$tmp/ref.exr" || return 1
 	mv "$tmp/time" "${dest%.exr}.time"
 	mv "$tmp/ref.exr" "$dest"	# last: a reference in the cache is complete
 	rm -rf "$tmp"
@@ -386,7 +447,9 @@ for item in "${pending[@]}"; do
 	IFS='|' read -r s sc p <<<"$item"
 	while ((${#JOBS[@]} >= NPAR)); do reap_one; done
 	job_start ref_job "$sc" "$s" "$p"
-	JOBDESC[$JOB]="$(basename "$sc" .pov) s=$s ($((s * W))x$((s * H)))|${p%.exr}.time"
+	k=$s
+	[[ -z ${GAMMA[$sc]} ]] || k=$((REF_R * s))
+	JOBDESC[$JOB]="$(basename "$sc" .pov) s=$s ($((k * W))x$((k * H))${GAMMA[$sc]:+, -A})|${p%.exr}.time"
 	echo "sweep: reference $(basename "$sc" .pov) s=$s started" >&2
 done
 while ((${#JOBS[@]})); do reap_one; done
@@ -554,6 +617,9 @@ for i in "${!scenes[@]}"; do
 	name=${names[$i]}
 	pd=$RUNTMP/plot-$name
 	mkdir -p "$pd"
+	refdesc="$((REF_SPP * REF_S * REF_S)) jittered samples per pixel"
+	[[ -z ${GAMMA[$sc]} ]] ||
+		refdesc="$((REF_R * REF_R * REF_S * REF_S)) samples per pixel, no antialiasing: assumed_gamma ${GAMMA[$sc]}"
 	for m in noaa am1 am2 scale; do
 		awk -F, -v n="$name" -v m="$m" '$1 == n && $2 == m { print $4, $6, $3 }' \
 			"$CSV" >"$pd/$m.dat"
@@ -569,7 +635,7 @@ for i in "${!scenes[@]}"; do
 		set output '$OUT/$name.png'
 		set title "$name.pov at ${W}x$H: POV-Ray alone (one thread) and povpress render" noenhanced
 		set xlabel 'CPU seconds (POV-Ray process; povpress and all its POV-Ray children)'
-		set ylabel 'relMSE against the reference ($((REF_SPP * REF_S * REF_S)) jittered samples per pixel)'
+		set ylabel 'relMSE against the reference ($refdesc)'
 		set logscale xy
 		set format y '%.0e'
 		set grid
@@ -679,6 +745,16 @@ mode=full
 	echo "The reference is the scene at its default knobs at s = $REF_S times the size, every"
 	echo "pixel of that supersampled with \`${REF_AA[*]}\` ($((REF_SPP * REF_S * REF_S)) samples per pixel"
 	echo "after box-averaging); ref$CHK_S is the same at s = $CHK_S. Budgets are multiples of the no-AA run's CPU time; \"AA\" is"
+	gs=()
+	for sc in "${scenes[@]}"; do
+		[[ -z ${GAMMA[$sc]} ]] || gs+=("$(basename "$sc" .pov) (${GAMMA[$sc]})")
+	done
+	if ((${#gs[@]})); then
+		echo "(A scene whose file sets assumed_gamma other than 1, in whose encoding POV-Ray's"
+		echo "antialiasing averages, has references by resolution scaling instead: at $REF_R s times"
+		echo "the size, \`-A\`, box-averaged, $((REF_R * REF_R * REF_S * REF_S)) samples per pixel at s = $REF_S: here"
+		echo "$(IFS=,; echo "${gs[*]}" | sed 's/,/, /g').)"
+	fi
 	echo "the best \`+AM1\`/\`+AM2\` run (thresholds ${THRESHOLDS[*]}, depths ${DEPTHS[*]}, \`+J\`)"
 	echo "within the budget, \"scaling\" the best of s = ${SCALES[*]} within it (s = 1 is the"
 	echo "no-AA render); the winner column says by what factor it has the lower relMSE."

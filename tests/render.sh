@@ -359,6 +359,32 @@ check "gamma: 1, or a value in comments and strings, is not another gamma" \
 "$PP" render "$T/gamma.pov" -o "$T/gamma-grid.exr" -W 40 -H 30 --max-passes 0 -q --sampler grid \
 	--report "$T/gamma-grid.json" -- +WT1 || bad "gamma, --sampler grid: render failed"
 check "gamma: --sampler grid is kept" grep -q '"sampler_chosen": "grid"' "$T/gamma-grid.json"
+# The benchmark reads the scene file as render does (scene_gamma in
+# scripts/sweep.sh: such a scene's references are rendered without
+# antialiasing).  The last gamma given as a number counts, not one in a
+# comment or a string, nor an expression.
+cat >"$T/gamma2.pov" <<'EOF'
+#version 3.7;
+#declare G = 1.5;
+global_settings { assumed_gamma
+  2.0 }
+global_settings { assumed_gamma G } // assumed_gamma 1.9
+/* assumed_gamma 2.2 */
+#declare S = "assumed_gamma 1.7 // not a comment";
+#declare my_assumed_gamma = 2.4;
+camera { location <0, 1, -3> look_at <0, 0.5, 0> }
+light_source { <2, 4, -3> rgb 1 }
+sphere { <0, 0.5, 0>, 0.5 pigment { rgb <1, 0.3, 0.2> } }
+EOF
+"$PP" render "$T/gamma2.pov" -o "$T/gamma2.exr" -W 40 -H 30 --max-passes 0 -q \
+	--report "$T/gamma2.json" -- +WT1 || bad "gamma 2: render failed"
+check "gamma: the last gamma given as a number (2.0)" grep -q '"assumed_gamma": 2,' "$T/gamma2.json"
+eval "$(sed -n '/^scene_gamma() {/,/^}/p' "$ROOT/scripts/sweep.sh")"
+check "gamma: the benchmark reads 1.8 where render does" test "$(scene_gamma "$T/gamma.pov")" = 1.8
+check "gamma: ... nothing where render reads 1" test -z "$(scene_gamma "$T/gamma1.pov")"
+check "gamma: ... 2 where render reads 2.0" test "$(scene_gamma "$T/gamma2.pov")" = 2
+check "gamma: ... and no gamma other than 1 in the bundled scenes" \
+	test -z "$(for sc in "$SC"/*.pov; do scene_gamma "$sc"; done)"
 
 # --- --sampler auto where the error sits in a few pixels: antialiasing first -
 # hdr_highlights' lamps and their reflections hold half the base pass's
