@@ -34,7 +34,7 @@
 # SCENE-WxH-jS-KEY.exr, KEY a hash of the scene file's contents, the size,
 # the scale, the settings and POV-Ray's version: editing a scene makes a new
 # reference.  (The hash does not cover files the scene includes.)  A scene
-# whose file sets assumed_gamma other than 1 is rendered at 3 s times the
+# whose file sets assumed_gamma other than 1 is rendered at 3s times the
 # size without antialiasing instead, box-averaged (9 s^2 samples per pixel on
 # a regular grid): POV-Ray's antialiasing averages in that gamma's encoding,
 # and the reference is the linear average (REF_SETTINGS_GAMMA below).
@@ -211,11 +211,13 @@ REF_SETTINGS="povray -D -GA +FE +WT1 ${REF_AA[*]} at scale s, box-averaged by bo
 # that gamma's encoding, and the linear box average of the samples is what
 # the reference stands for (and what povpress render's scale renders, and
 # boxdown, compute).  Debian's advanced/isocacti (assumed_gamma 1.3) at
-# 80x60: the antialiased references at scales 9 and 5 were 2.4e-3 and
-# 4.9e-3 from the frame at scale 27 without antialiasing, box-averaged,
-# where ref9 and ref5 were 1.4e-3 apart.  There each reference pixel
-# becomes REF_R x REF_R pixels: the scene at REF_R s times the size, -A,
-# box-averaged by REF_R s, REF_R^2 s^2 samples a pixel on a regular grid.
+# 80x60: the antialiased references at scales 9 and 5 were relMSE 2.05e-3
+# and 3.9e-3 from the new ref9 (the frame at scale 27 without
+# antialiasing, box-averaged), where the new ref9 and ref5 were 9.0e-4
+# apart.  There each reference pixel becomes REF_R x REF_R pixels: the scene
+# at REF_R s times the size, -A, box-averaged by REF_R s, REF_R^2 s^2
+# samples a pixel on a regular grid (at s = 15 and 160x120 a 7200x5400
+# frame, about 1 GB for boxdown, two references at a time).
 # A regular grid quantizes a straight edge along its rows (Debian's
 # lights/shadows' horizon row read 0.372 at scale 9 where the truth is
 # between 0.355 and 0.372: README), on that scene a smaller error than the
@@ -231,7 +233,7 @@ scene_gamma() {
 	LC_ALL=C awk 'BEGIN { RS = "\001" }
 	function wordch(c) { return c ~ /[A-Za-z0-9_]/ }
 	{
-		t = t $0
+		t = t (NR > 1 ? "\001" : "") $0
 	}
 	END {
 		n = length(t); g = ""
@@ -251,12 +253,12 @@ scene_gamma() {
 				i += j
 			} else if (substr(t, i, 13) == "assumed_gamma" &&
 				   !(i > 1 && wordch(substr(t, i - 1, 1))) && !wordch(substr(t, i + 13, 1))) {
-				if (match(substr(t, i + 13), /^[ \t\r\n]*[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?/))
+				if (match(substr(t, i + 13), /^[ \t\r\n\v\f]*[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?/))
 					g = substr(t, i + 13, RLENGTH) + 0
 				i += 12
 			}
 		}
-		if (g != "" && g > 0 && (g - 1 > 0.01 || 1 - g > 0.01))
+		if (g != "" && g > 0 && g < 1e300 && (g - 1 > 0.01 || 1 - g > 0.01))
 			print g
 	}' "$1"
 }
@@ -448,7 +450,7 @@ for item in "${pending[@]}"; do
 	while ((${#JOBS[@]} >= NPAR)); do reap_one; done
 	job_start ref_job "$sc" "$s" "$p"
 	k=$s
-	[[ -z ${GAMMA[$sc]} ]] || k=$((REF_R * s))
+	[[ -z ${GAMMA[$sc]:-} ]] || k=$((REF_R * s))
 	JOBDESC[$JOB]="$(basename "$sc" .pov) s=$s ($((k * W))x$((k * H))${GAMMA[$sc]:+, -A})|${p%.exr}.time"
 	echo "sweep: reference $(basename "$sc" .pov) s=$s started" >&2
 done
@@ -618,8 +620,8 @@ for i in "${!scenes[@]}"; do
 	pd=$RUNTMP/plot-$name
 	mkdir -p "$pd"
 	refdesc="$((REF_SPP * REF_S * REF_S)) jittered samples per pixel"
-	[[ -z ${GAMMA[$sc]} ]] ||
-		refdesc="$((REF_R * REF_R * REF_S * REF_S)) samples per pixel, no antialiasing: assumed_gamma ${GAMMA[$sc]}"
+	[[ -z ${GAMMA[$sc]:-} ]] ||
+		refdesc="$((REF_R * REF_R * REF_S * REF_S)) samples per pixel, no antialiasing: assumed_gamma ${GAMMA[$sc]:-}"
 	for m in noaa am1 am2 scale; do
 		awk -F, -v n="$name" -v m="$m" '$1 == n && $2 == m { print $4, $6, $3 }' \
 			"$CSV" >"$pd/$m.dat"
@@ -745,19 +747,20 @@ mode=full
 	echo "The reference is the scene at its default knobs at s = $REF_S times the size, every"
 	echo "pixel of that supersampled with \`${REF_AA[*]}\` ($((REF_SPP * REF_S * REF_S)) samples per pixel"
 	echo "after box-averaging); ref$CHK_S is the same at s = $CHK_S. Budgets are multiples of the no-AA run's CPU time; \"AA\" is"
-	gs=()
-	for sc in "${scenes[@]}"; do
-		[[ -z ${GAMMA[$sc]} ]] || gs+=("$(basename "$sc" .pov) (${GAMMA[$sc]})")
-	done
-	if ((${#gs[@]})); then
-		echo "(A scene whose file sets assumed_gamma other than 1, in whose encoding POV-Ray's"
-		echo "antialiasing averages, has references by resolution scaling instead: at $REF_R s times"
-		echo "the size, \`-A\`, box-averaged, $((REF_R * REF_R * REF_S * REF_S)) samples per pixel at s = $REF_S: here"
-		echo "$(IFS=,; echo "${gs[*]}" | sed 's/,/, /g').)"
-	fi
 	echo "the best \`+AM1\`/\`+AM2\` run (thresholds ${THRESHOLDS[*]}, depths ${DEPTHS[*]}, \`+J\`)"
 	echo "within the budget, \"scaling\" the best of s = ${SCALES[*]} within it (s = 1 is the"
 	echo "no-AA render); the winner column says by what factor it has the lower relMSE."
+	gs=()
+	for sc in "${scenes[@]}"; do
+		[[ -z ${GAMMA[$sc]:-} ]] || gs+=("$(basename "$sc" .pov) (${GAMMA[$sc]:-})")
+	done
+	if ((${#gs[@]})); then
+		echo "A scene whose file sets assumed_gamma other than 1, in whose encoding POV-Ray's"
+		echo "antialiasing averages, has references by resolution scaling instead: at ${REF_R}s times"
+		echo "the size, \`-A\`, box-averaged by ${REF_R}s, $((REF_R * REF_R * REF_S * REF_S)) samples per pixel at s = $REF_S on"
+		echo "a regular grid, whose shared error at straight edges the \"own\" column below does not"
+		echo "see: here $(IFS=,; echo "${gs[*]}" | sed 's/,/, /g')."
+	fi
 	echo "Data: \`sweep.csv\`; plots: \`<scene>.png\`."
 	echo
 	echo "The no-AA CPU time is the mean of the noaa and s = 1 runs (the same render"
