@@ -268,6 +268,19 @@ scene_gamma() {
 }
 for sc in "${scenes[@]}"; do GAMMA[$sc]=$(scene_gamma "$sc"); done
 
+# ref_method SCENE S: how the scene's reference at scale S is rendered:
+# RK, the frame's scale over the image; RAA, POV-Ray's antialiasing
+# options; RSET, the settings its cache key names; RSPP, its samples a
+# pixel after box-averaging.
+ref_method() {
+	if [[ -n ${GAMMA[$1]:-} ]]; then
+		RK=$((REF_R * $2)) RAA=(-A) RSET=$REF_SETTINGS_GAMMA
+		RSPP=$((REF_R * REF_R * $2 * $2))
+	else
+		RK=$2 RAA=("${REF_AA[@]}") RSET=$REF_SETTINGS RSPP=$((REF_SPP * $2 * $2))
+	fi
+}
+
 mkdir -p "$CACHE" "$OUT"
 OUT=$(cd "$OUT" && pwd)
 check_path "$OUT"
@@ -369,13 +382,13 @@ timed_povpress() {
 # ---- references
 
 ref_path() { # SCENE S: the cache file of the scene's reference at scale S
-	local key settings=$REF_SETTINGS
-	[[ -z ${GAMMA[$1]:-} ]] || settings=$REF_SETTINGS_GAMMA
+	local key
+	ref_method "$1" "$2"
 	key=$({
 		echo "povpress sweep reference 1"
 		echo "size ${W}x$H"
 		echo "scale $2"
-		echo "settings $settings"
+		echo "settings $RSET"
 		echo "version $POV_VERSION"
 		sha256sum <"$1"
 	} | sha256sum | cut -c1-16)
@@ -383,16 +396,16 @@ ref_path() { # SCENE S: the cache file of the scene's reference at scale S
 }
 
 ref_job() { # SCENE S DEST: render the reference into DEST (runs inside a job)
-	local scene=$1 s=$2 dest=$3 tmp k=$2 aa=("${REF_AA[@]}")
-	[[ -z ${GAMMA[$1]:-} ]] || { k=$((REF_R * s)) aa=(-A); }
+	local scene=$1 dest=$3 tmp
+	ref_method "$scene" "$2"
 	tmp=$(mktemp -d "$RUNTMP/ref.XXXXXX")
-	pov_args $((k * W)) $((k * H)) "$tmp/hi.exr" "$scene"
-	if ! timed_povray "$tmp/time" "$tmp/log" "${POV[@]}" "${aa[@]}"; then
-		echo "sweep: povray failed on '$scene' at scale $k:" >&2
+	pov_args $((RK * W)) $((RK * H)) "$tmp/hi.exr" "$scene"
+	if ! timed_povray "$tmp/time" "$tmp/log" "${POV[@]}" "${RAA[@]}"; then
+		echo "sweep: povray failed on '$scene' at scale $RK:" >&2
 		tail -n 15 "$tmp/log" >&2
 		return 1
 	fi
-	"$BOXDOWN" "$tmp/hi.exr" "$k" "$tmp/ref.exr" || return 1
+	"$BOXDOWN" "$tmp/hi.exr" "$RK" "$tmp/ref.exr" || return 1
 	mv "$tmp/time" "${dest%.exr}.time"
 	mv "$tmp/ref.exr" "$dest"	# last: a reference in the cache is complete
 	rm -rf "$tmp"
@@ -453,9 +466,8 @@ for item in "${pending[@]}"; do
 	IFS='|' read -r s sc p <<<"$item"
 	while ((${#JOBS[@]} >= NPAR)); do reap_one; done
 	job_start ref_job "$sc" "$s" "$p"
-	k=$s
-	[[ -z ${GAMMA[$sc]:-} ]] || k=$((REF_R * s))
-	JOBDESC[$JOB]="$(basename "$sc" .pov) s=$s ($((k * W))x$((k * H))${GAMMA[$sc]:+, -A})|${p%.exr}.time"
+	ref_method "$sc" "$s"
+	JOBDESC[$JOB]="$(basename "$sc" .pov) s=$s ($((RK * W))x$((RK * H))${GAMMA[$sc]:+, -A})|${p%.exr}.time"
 	echo "sweep: reference $(basename "$sc" .pov) s=$s started" >&2
 done
 while ((${#JOBS[@]})); do reap_one; done
@@ -623,9 +635,10 @@ for i in "${!scenes[@]}"; do
 	name=${names[$i]}
 	pd=$RUNTMP/plot-$name
 	mkdir -p "$pd"
-	refdesc="$((REF_SPP * REF_S * REF_S)) jittered samples per pixel"
+	ref_method "$sc" "$REF_S"
+	refdesc="$RSPP jittered samples per pixel"
 	[[ -z ${GAMMA[$sc]:-} ]] ||
-		refdesc="$((REF_R * REF_R * REF_S * REF_S)) samples per pixel, no antialiasing: assumed_gamma ${GAMMA[$sc]:-}"
+		refdesc="$RSPP samples per pixel, no antialiasing: assumed_gamma ${GAMMA[$sc]}"
 	for m in noaa am1 am2 scale; do
 		awk -F, -v n="$name" -v m="$m" '$1 == n && $2 == m { print $4, $6, $3 }' \
 			"$CSV" >"$pd/$m.dat"
@@ -756,7 +769,7 @@ mode=full
 	echo "no-AA render); the winner column says by what factor it has the lower relMSE."
 	gs=()
 	for sc in "${scenes[@]}"; do
-		[[ -z ${GAMMA[$sc]:-} ]] || gs+=("$(basename "$sc" .pov) (${GAMMA[$sc]:-})")
+		[[ -z ${GAMMA[$sc]:-} ]] || gs+=("$(basename "$sc" .pov) (${GAMMA[$sc]})")
 	done
 	if ((${#gs[@]})); then
 		echo "A scene whose file sets assumed_gamma other than 1, in whose encoding POV-Ray's"

@@ -911,9 +911,6 @@ static void test_merge_aa(void **state)
 	image_release(&acc);
 }
 
-/* The cells an edge render's spread is divided over (ACC_AA_EDGE), as the
- * header gives them: 1 up to a tenth of the threshold, `cells` from it,
- * geometric between. */
 /* The hidden-edge term of a pixel of value v whose neighbour differs by d
  * (grey, no spread), its finest scale s, before the share: the mean of
  * (alpha d)^2 / ((v + alpha d)^2 + 0.01) over alpha in [0, 1/(2s)], by the
@@ -923,11 +920,14 @@ static double edge_strip(double v, double d, int s)
 	double e = 0.0;
 	for (int k = 0; k < 4; k++) {
 		double m = (k + 0.5) / (8.0 * s) * d;
-		e += m * m / ((v + m) * (v + m) + 0.01) / 4.0;
+		e += m * m / ((v + m) * (v + m) + METRICS_RELMSE_EPS) / 4.0;
 	}
 	return e;
 }
 
+/* The cells an edge render's spread is divided over (ACC_AA_EDGE), as the
+ * header gives them: 1 up to a tenth of the threshold, `cells` from it,
+ * geometric between. */
 static double edge_cells_want(double range, double cells)
 {
 	if (range <= ACC_AA_THRESHOLD / 10.0)
