@@ -23,4 +23,7 @@ int cmd_plan(int argc, char **argv);
 /* povpress merge: fold region renders into an accumulation. */
 int cmd_merge(int argc, char **argv);
 
+/* povpress scene SCENE.pov: what render reads from the scene file. */
+int cmd_scene(int argc, char **argv);
+
 #endif

@@ -20,6 +20,8 @@ static const char usage[] =
 	"  analyze IN.exr -o OUT.exr   reconstruction, error estimate, order, bandwidth,\n"
 	"                              gradients of an image\n"
 	"  compare IMAGE.exr REF.exr   relMSE, MSE and PSNR of an image against a reference\n"
+	"  scene SCENE.pov             what render reads from a scene file itself\n"
+	"                              (assumed_gamma, focal blur, radiosity)\n"
 	"\n"
 	"Run 'povpress COMMAND --help' for a command's options.\n";
 
@@ -44,6 +46,8 @@ int main(int argc, char **argv)
 		return cmd_merge(argc - 1, argv + 1);
 	if (!strcmp(cmd, "compare"))
 		return cmd_compare(argc - 1, argv + 1);
+	if (!strcmp(cmd, "scene"))
+		return cmd_scene(argc - 1, argv + 1);
 	fprintf(stderr, "povpress: unknown command '%s'\n\n%s", cmd, usage);
 	return 2;
 }

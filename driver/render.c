@@ -21,6 +21,7 @@
 #include "driver/metrics.h"
 #include "driver/plan.h"
 #include "driver/povray.h"
+#include "driver/scene.h"
 #include "regression/lpr.h"
 
 #include <ctype.h>
@@ -276,6 +277,9 @@ struct run {
 				 * (scene_assumed_gamma()), else 0: under
 				 * --sampler auto resolution scaling only, no
 				 * antialiased render (run_grid()) */
+	int rad_named;		/* the scene file's text holds "radiosity"
+				 * (scene_keys): its radiosity pass starts with
+				 * the base pass (prelaunch_first()) */
 	struct pass_rec *passes;
 	size_t npasses;
 	const char *stop;
@@ -1195,126 +1199,6 @@ static void prelaunch_start(struct run *r, int pass, const struct pre_kind *kind
 	free(extras);
 }
 
-/* Whether the scene file's text holds word (not the files it includes). */
-static int scene_mentions(const char *path, const char *word)
-{
-	char *text = file_read_text(path);
-	int found = text && strstr(text, word);	/* text: a NUL ends the search */
-	free(text);
-	return found;
-}
-
-/* Whether word w starts at t[i] as a word of the scene language. */
-static int word_at(const char *t, size_t i, const char *w)
-{
-	size_t n = strlen(w);
-	if (strncmp(t + i, w, n))
-		return 0;
-	int before = i > 0 && (isalnum((unsigned char)t[i - 1]) || t[i - 1] == '_');
-	int after = isalnum((unsigned char)t[i + n]) || t[i + n] == '_';
-	return !before && !after;
-}
-
-/* The number after the keyword at t[i] (sizeof key - 1 long), or NAN. */
-static double number_after(const char *t, size_t i, size_t keylen)
-{
-	const char *v = t + i + keylen;
-	char *end;
-	double x = strtod(v, &end);
-	return end == v ? NAN : x;
-}
-
-/* What the scene file (not what it includes) says outside comments and
- * strings, for scene_focal_blur() and scene_assumed_gamma(). */
-struct scene_keys {
-	int aperture;		/* "aperture", but for "aperture 0" */
-	int blur_samples;
-	double gamma;		/* the last assumed_gamma given as a number, or 1 */
-};
-
-/* Scan the scene text t into *k, read once. */
-static void scene_scan(const char *t, struct scene_keys *k)
-{
-	for (size_t i = 0; t[i]; i++) {
-		if (t[i] == '/' && t[i + 1] == '/') {
-			while (t[i + 1] && t[i + 1] != '\n')
-				i++;
-		} else if (t[i] == '/' && t[i + 1] == '*') {
-			i += 2;
-			while (t[i] && !(t[i] == '*' && t[i + 1] == '/'))
-				i++;
-			if (!t[i])
-				break;
-			i++;
-		} else if (t[i] == '"') {
-			while (t[i + 1] && t[i + 1] != '"' && t[i + 1] != '\n')
-				i++;
-			if (t[i + 1])
-				i++;
-		} else if (word_at(t, i, "aperture")) {
-			/* "aperture 0" is a camera without focal blur */
-			k->aperture |= !(number_after(t, i, sizeof "aperture" - 1) == 0.0);
-		} else if (word_at(t, i, "blur_samples")) {
-			k->blur_samples = 1;
-		} else if (word_at(t, i, "assumed_gamma")) {
-			double x = number_after(t, i, sizeof "assumed_gamma" - 1);
-			if (isfinite(x))
-				k->gamma = x;
-		}
-	}
-}
-
-/* The scene file's keys (none where it cannot be read). */
-static struct scene_keys scene_read_keys(const char *path)
-{
-	struct scene_keys k = { 0, 0, 1.0 };
-	char *t = file_read_text(path);
-	if (t)
-		scene_scan(t, &k);
-	free(t);
-	return k;
-}
-
-/*
- * Whether the scene file (not what it includes) names both of focal blur's
- * camera keywords, aperture (but for "aperture 0") and blur_samples,
- * outside comments and strings.  There
- * POV-Ray's antialiasing converges far more slowly than resolution scaling:
- * each antialiasing sub-sample traces its own blur samples, whose sub-pixel
- * offsets come from a table indexed by the position (tracepixel.cpp), so
- * the sub-samples of a pixel share much of their pattern.  focal_blur at
- * 160x120, the whole frame against the sweep's reference: +AM1 +A0.0 +R8
- * +J0.75 at twice the size (256 samples a pixel) 7.8e-5, resolution
- * scaling at 8 (64) 7.8e-5 and at 16 (256) 2.3e-5; on the other bundled
- * scenes the grid renders did as well as scaling or better (README).
- */
-static int scene_focal_blur(const struct scene_keys *k)
-{
-	return k->aperture && k->blur_samples;
-}
-
-/*
- * The value the scene file (not what it includes) gives assumed_gamma,
- * outside comments and strings, when it is a number other than 1 (the
- * last such); 0 where it gives none, gives 1, or gives an expression.
- * There POV-Ray's antialiasing averages its samples in that gamma's
- * encoding, not linearly as resolution scaling's box average does: grid
- * renders and antialiased renders are biased against the linear
- * reference.  Debian's advanced/biscuit (assumed_gamma 1.3) at 160x120,
- * the whole frame against resolution scaling at 15: +AM1 +A0.0 +R4 +J0
- * (scale 4's positions and the centre) 3.8e-3, scaling at 4 1.33e-3, the
- * grid render at scale 4 (+AM1 +A0.0 +R2 +J0.75 at twice the size)
- * 2.36e-3.  povpress render there, --sampler auto against scale: --target
- * 1e-3 7.2e-4 in 8.8 CPU s against 1.7e-4 in 9.2 s; advanced/pawns (1.8)
- * 1.33e-3 in 7.5 s against 4.5e-4 in 8.5 s; lights/spotlite (2.2) at
- * --budget 3 5.3e-4 against 5.7e-5.
- */
-static double scene_assumed_gamma(const struct scene_keys *k)
-{
-	const double g = k->gamma;
-	return fabs(g - 1.0) > 0.01 && g > 0.0 ? g : 0.0;
-}
-
 /*
  * For a scene whose file mentions radiosity: the radiosity pass started
  * during the base pass, waiting at its gate, at each scale it may take
@@ -1362,7 +1246,7 @@ static void prelaunch_radiosity(struct run *r)
  * the base pass), but its radiosity pass. */
 static void prelaunch_first(struct run *r)
 {
-	if (scene_mentions(r->scene, "radiosity")) {
+	if (r->rad_named) {
 		prelaunch_radiosity(r);
 		return;
 	}
@@ -2395,7 +2279,13 @@ bad:
 			      strerror(errno));
 		goto fail_early;
 	}
-	const struct scene_keys keys = scene_read_keys(r.scene);
+	struct scene_keys keys;
+	if (scene_read(r.scene, &keys)) {
+		errbuf_printf(err, sizeof err, "cannot read scene '%s': %s", r.scene,
+			      strerror(errno));
+		goto fail_early;
+	}
+	r.rad_named = keys.radiosity;
 	r.focal = r.grid == PLAN_GRID_LARGE && !r.aa && scene_focal_blur(&keys);
 	r.gamma = scene_assumed_gamma(&keys);
 	{

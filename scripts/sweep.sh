@@ -229,42 +229,15 @@ REF_SETTINGS="povray -D -GA +FE +WT1 ${REF_AA[*]} at scale s, box-averaged by bo
 # samples without antialiasing.
 REF_SETTINGS_GAMMA="povray -D -GA +FE +WT1 -A at scale $REF_R s, box-averaged by boxdown"
 
-# scene_gamma SCENE: the assumed_gamma the scene file (not what it includes)
-# gives as a number other than 1, outside comments and strings (the last
-# one given as a number), as povpress render reads it; nothing where it
-# gives none, 1, or an expression.
+# scene_gamma SCENE: the assumed_gamma the scene file gives, as povpress
+# render reads it (`povpress scene`), where it is not 1; nothing where it
+# is 1 (or the file gives none, or an expression).
 scene_gamma() {
-	LC_ALL=C awk 'BEGIN { RS = "\001" }
-	function wordch(c) { return c ~ /[A-Za-z0-9_]/ }
-	{
-		t = t (NR > 1 ? "\001" : "") $0
-	}
-	END {
-		n = length(t); g = ""
-		for (i = 1; i <= n; i++) {
-			c2 = substr(t, i, 2)
-			if (c2 == "//") {
-				j = index(substr(t, i), "\n")
-				if (!j) break
-				i += j - 2
-			} else if (c2 == "/*") {
-				j = index(substr(t, i + 2), "*/")
-				if (!j) break
-				i += j + 2
-			} else if (substr(t, i, 1) == "\"") {
-				j = match(substr(t, i + 1), /["\n]/)
-				if (!j) break
-				i += j
-			} else if (substr(t, i, 13) == "assumed_gamma" &&
-				   !(i > 1 && wordch(substr(t, i - 1, 1))) && !wordch(substr(t, i + 13, 1))) {
-				if (match(substr(t, i + 13), /^[ \t\r\n\v\f]*[-+]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][-+]?[0-9]+)?/))
-					g = substr(t, i + 13, RLENGTH) + 0
-				i += 12
-			}
-		}
-		if (g != "" && g > 0 && g < 1e300 && (g - 1 > 0.01 || 1 - g > 0.01))
-			print g
-	}' "$1"
+	local g
+	g=$("$POVPRESS" scene "$1" | sed -n 's/^assumed_gamma: //p') ||
+		die "cannot read scene '$1'"
+	[[ -n $g ]] || die "povpress scene gave no assumed_gamma for '$1'"
+	[[ $g == 1 ]] || echo "$g"
 }
 for sc in "${scenes[@]}"; do GAMMA[$sc]=$(scene_gamma "$sc"); done
 

@@ -202,6 +202,40 @@ check "compare: unreadable file is an error naming it" \
 out=$("$PP" compare "$T/quad.exr" "$T/quad.exr")
 check "compare: an image against itself has relmse 0" num 'a == 0' "$(cmpval "$out" relmse)"
 
+# --- povpress scene: what render reads from a scene file ----------------------
+# (tests/render.sh checks that render reads the same; here the printing and
+# the errors)
+cat >"$T/keys.pov" <<'EOF'
+// assumed_gamma 1.5 in a comment; aperture 0.3 too
+#declare use_radiosity = 0;
+global_settings { assumed_gamma 2.2 }
+camera { location <0, 1, -3> look_at 0 aperture 0.3 blur_samples 8 focal_point 0 }
+EOF
+out=$("$PP" scene "$T/keys.pov" 2>"$T/scene.err")
+check "scene: three lines, nothing on stderr" \
+	test "$(wc -l <<<"$out")" = 3 -a ! -s "$T/scene.err"
+check "scene: the gamma given as a number" grep -qx "assumed_gamma: 2.2" <<<"$out"
+check "scene: focal blur from aperture and blur_samples" grep -qx "focal_blur: yes" <<<"$out"
+check "scene: radiosity named (in a name)" grep -qx "radiosity: yes" <<<"$out"
+sed 's/aperture 0.3 blur/aperture 0 blur/; s/use_radiosity/use_rad/' "$T/keys.pov" >"$T/keys0.pov"
+out=$("$PP" scene "$T/keys0.pov")
+check "scene: aperture 0 is no focal blur" grep -qx "focal_blur: no" <<<"$out"
+check "scene: no radiosity named" grep -qx "radiosity: no" <<<"$out"
+scene_fails() { # DESCRIPTION STATUS MESSAGE ARGS...: povpress scene ARGS fails so
+	local d=$1 want=$2 m=$3 msg rc
+	shift 3
+	msg=$("$PP" scene "$@" 2>&1)
+	rc=$?
+	check "scene: $d: exit $want, saying \"$m\"" \
+		sh -c 'test "$1" = "$2" && printf "%s" "$3" | grep -qF -- "$4"' _ "$rc" "$want" "$msg" "$m"
+}
+scene_fails "a missing file" 1 "cannot read scene '$T/none.pov'" "$T/none.pov"
+scene_fails "a directory" 1 "cannot read scene '$T': Is a directory" "$T"
+scene_fails "no file" 2 "no scene file given"
+scene_fails "two files" 2 "one scene file" "$T/keys.pov" "$T/keys0.pov"
+scene_fails "an unknown option" 2 "unknown option '--gamma'" --gamma "$T/keys.pov"
+check "scene: --help" sh -c '"$1" scene --help | grep -q "^usage: povpress scene"' _ "$PP"
+
 # --- a POV-Ray render of a bundled scene ---------------------------------------------
 cp "$ROOT/scenes/soft_shadows.pov" "$T/scene.pov"
 povray -D -GA +W96 +H72 +FE +WT1 "+O$T/render.exr" "+I$T/scene.pov" "+L$ROOT/scenes" \

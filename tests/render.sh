@@ -359,10 +359,10 @@ check "gamma: 1, or a value in comments and strings, is not another gamma" \
 "$PP" render "$T/gamma.pov" -o "$T/gamma-grid.exr" -W 40 -H 30 --max-passes 0 -q --sampler grid \
 	--report "$T/gamma-grid.json" -- +WT1 || bad "gamma, --sampler grid: render failed"
 check "gamma: --sampler grid is kept" grep -q '"sampler_chosen": "grid"' "$T/gamma-grid.json"
-# The benchmark reads the scene file as render does (scene_gamma in
-# scripts/sweep.sh: such a scene's references are rendered without
-# antialiasing).  The last gamma given as a number counts, not one in a
-# comment or a string, nor an expression.
+# povpress scene prints what render reads from the scene file (and the
+# benchmark reads a scene's gamma through it: such a scene's references are
+# rendered without antialiasing).  The last gamma given as a number counts,
+# not one in a comment or a string, nor an expression.
 cat >"$T/gamma2.pov" <<'EOF'
 #version 3.7;
 #declare G = 1.5;
@@ -379,13 +379,19 @@ EOF
 "$PP" render "$T/gamma2.pov" -o "$T/gamma2.exr" -W 40 -H 30 --max-passes 0 -q \
 	--report "$T/gamma2.json" -- +WT1 || bad "gamma 2: render failed"
 check "gamma: the last gamma given as a number (2.0)" grep -q '"assumed_gamma": 2,' "$T/gamma2.json"
-eval "$(sed -n '/^scene_gamma() {/,/^}/p' "$ROOT/scripts/sweep.sh")"
-check "gamma: the benchmark reads 1.8 where render does" test "$(scene_gamma "$T/gamma.pov")" = 1.8
-check "gamma: ... nothing where render reads 1" test -z "$(scene_gamma "$T/gamma1.pov")"
-check "gamma: ... 2 where render reads 2.0" test "$(scene_gamma "$T/gamma2.pov")" = 2
-check "gamma: ... 2.2 in scenes/legacy_gamma.pov and no other gamma in the bundled scenes" \
-	test "$(for sc in "$SC"/*.pov; do echo "$(basename "$sc") $(scene_gamma "$sc")"; done |
-		awk 'NF > 1')" = "legacy_gamma.pov 2.2"
+scene_key() { "$PP" scene "$1" | sed -n "s/^$2: //p"; }
+check "scene: 1.8 where render reads 1.8" test "$(scene_key "$T/gamma.pov" assumed_gamma)" = 1.8
+check "scene: 1 where render reads 1" test "$(scene_key "$T/gamma1.pov" assumed_gamma)" = 1
+check "scene: 2 where render reads 2.0" test "$(scene_key "$T/gamma2.pov" assumed_gamma)" = 2
+check "scene: 2.2 in scenes/legacy_gamma.pov and no other gamma in the bundled scenes" \
+	test "$(for sc in "$SC"/*.pov; do echo "$(basename "$sc") $(scene_key "$sc" assumed_gamma)"; done |
+		awk '$2 != 1')" = "legacy_gamma.pov 2.2"
+check "scene: focal blur in scenes/focal_blur.pov alone" \
+	test "$(for sc in "$SC"/*.pov; do echo "$(basename "$sc") $(scene_key "$sc" focal_blur)"; done |
+		awk '$2 == "yes" { print $1 }')" = "focal_blur.pov"
+check "scene: radiosity named in scenes/radiosity_room.pov alone" \
+	test "$(for sc in "$SC"/*.pov; do echo "$(basename "$sc") $(scene_key "$sc" radiosity)"; done |
+		awk '$2 == "yes" { print $1 }')" = "radiosity_room.pov"
 
 # --- --sampler auto where the error sits in a few pixels: antialiasing first -
 # hdr_highlights' lamps and their reflections hold half the base pass's
