@@ -2282,7 +2282,7 @@ bad:
 	struct scene_keys keys;
 	if (scene_read(r.scene, &keys)) {
 		errbuf_printf(err, sizeof err, "cannot read scene '%s': %s", r.scene,
-			      strerror(errno));
+			      errno == EINVAL ? "not a regular file" : strerror(errno));
 		goto fail_early;
 	}
 	r.rad_named = keys.radiosity;

@@ -79,8 +79,8 @@ int scene_read(const char *path, struct scene_keys *k)
 	struct stat st;
 	if (stat(path, &st))
 		return -1;
-	if (S_ISDIR(st.st_mode)) {
-		errno = EISDIR;
+	if (!S_ISREG(st.st_mode)) {	/* a directory, a device, a pipe */
+		errno = S_ISDIR(st.st_mode) ? EISDIR : EINVAL;
 		return -1;
 	}
 	errno = 0;
@@ -144,7 +144,8 @@ static const char scene_usage[] =
 	"\n"
 	"  assumed_gamma: G     the assumed_gamma the file gives as a number outside\n"
 	"                       comments and strings (the last one given); 1 where\n"
-	"                       it gives none, 1 (within 0.01) or an expression.\n"
+	"                       it gives none, an expression, 1 (to 0.01), or 0\n"
+	"                       or less.\n"
 	"                       Other than 1, --sampler auto refines by resolution\n"
 	"                       scaling alone: POV-Ray's antialiasing averages its\n"
 	"                       samples in that gamma's encoding\n"
@@ -153,12 +154,14 @@ static const char scene_usage[] =
 	"                       blur_samples, outside comments and strings; under\n"
 	"                       --sampler auto frames are then scaled up to\n"
 	"                       8 Mpixels before region renders turn to grids\n"
-	"  radiosity: yes|no    whether its text holds \"radiosity\" anywhere:\n"
-	"                       render then starts its radiosity pass with the base\n"
-	"                       pass (whether the scene has radiosity at all,\n"
-	"                       POV-Ray's statistics tell)\n"
+	"  radiosity: yes|no    whether its text holds \"radiosity\" anywhere\n"
+	"                       (comments and names such as use_radiosity too):\n"
+	"                       render then may start its radiosity pass with the\n"
+	"                       base pass (--prelaunch); whether the scene has\n"
+	"                       radiosity at all, POV-Ray's statistics tell\n"
 	"\n"
-	"Exit status: 0 done, 1 the file cannot be read, 2 bad usage.\n";
+	"Exit status: 0 done, 1 the file cannot be read (or is not a regular file)\n"
+	"or the output cannot be written, 2 bad usage.\n";
 
 int cmd_scene(int argc, char **argv)
 {
@@ -192,7 +195,7 @@ int cmd_scene(int argc, char **argv)
 	struct scene_keys k;
 	if (scene_read(path, &k)) {
 		fprintf(stderr, "povpress scene: cannot read scene '%s': %s\n", path,
-			strerror(errno));
+			errno == EINVAL ? "not a regular file" : strerror(errno));
 		return 1;
 	}
 	const double g = scene_assumed_gamma(&k);

@@ -19,13 +19,16 @@ struct scene_keys {
 				 * tell) */
 };
 
-/* Scan the NUL-terminated scene text t into *k, which starts as
- * scene_keys_init() leaves it. */
+/* *k as for a file that says nothing: no focal blur, gamma 1. */
 void scene_keys_init(struct scene_keys *k);
+
+/* Scan the NUL-terminated scene text t into *k, which starts as
+ * scene_keys_init() leaves it (radiosity is scene_read()'s). */
 void scene_scan(const char *t, struct scene_keys *k);
 
 /* Read and scan the scene file at path.  Returns 0, or -1 with errno set
- * when the file cannot be read (*k then as scene_keys_init() leaves it). */
+ * when it cannot be read: EISDIR for a directory, EINVAL for another file
+ * that is not a regular one (*k then as scene_keys_init() leaves it). */
 int scene_read(const char *path, struct scene_keys *k);
 
 /* Whether the file names both of focal blur's camera keywords, aperture

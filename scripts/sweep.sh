@@ -235,7 +235,7 @@ REF_SETTINGS_GAMMA="povray -D -GA +FE +WT1 -A at scale $REF_R s, box-averaged by
 scene_gamma() {
 	local g
 	g=$("$POVPRESS" scene "$1" | sed -n 's/^assumed_gamma: //p') ||
-		die "cannot read scene '$1'"
+		die "'$POVPRESS scene' failed on '$1' (a build from before 'povpress scene'?)"
 	[[ -n $g ]] || die "povpress scene gave no assumed_gamma for '$1'"
 	[[ $g == 1 ]] || echo "$g"
 }

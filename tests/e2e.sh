@@ -203,8 +203,8 @@ out=$("$PP" compare "$T/quad.exr" "$T/quad.exr")
 check "compare: an image against itself has relmse 0" num 'a == 0' "$(cmpval "$out" relmse)"
 
 # --- povpress scene: what render reads from a scene file ----------------------
-# (tests/render.sh checks that render reads the same; here the printing and
-# the errors)
+# (tests/render.sh checks that render reads the same gamma, and the bundled
+# scenes' keys; here the printing and the errors)
 cat >"$T/keys.pov" <<'EOF'
 // assumed_gamma 1.5 in a comment; aperture 0.3 too
 #declare use_radiosity = 0;
@@ -231,10 +231,16 @@ scene_fails() { # DESCRIPTION STATUS MESSAGE ARGS...: povpress scene ARGS fails 
 }
 scene_fails "a missing file" 1 "cannot read scene '$T/none.pov'" "$T/none.pov"
 scene_fails "a directory" 1 "cannot read scene '$T': Is a directory" "$T"
+scene_fails "a device" 1 "cannot read scene '/dev/zero': not a regular file" /dev/zero
 scene_fails "no file" 2 "no scene file given"
 scene_fails "two files" 2 "one scene file" "$T/keys.pov" "$T/keys0.pov"
 scene_fails "an unknown option" 2 "unknown option '--gamma'" --gamma "$T/keys.pov"
-check "scene: --help" sh -c '"$1" scene --help | grep -q "^usage: povpress scene"' _ "$PP"
+check "scene: --help, exit 0" \
+	bash -c 'set -o pipefail; "$1" scene --help | grep -q "^usage: povpress scene"' _ "$PP"
+cp "$T/keys.pov" "$T/-k.pov"
+check "scene: a file after --, though it looks like an option" \
+	bash -c 'set -o pipefail; cd "$1" && "$2" scene -- -k.pov | grep -qx "assumed_gamma: 2.2"' \
+	_ "$T" "$(readlink -f "$PP")"
 
 # --- a POV-Ray render of a bundled scene ---------------------------------------------
 cp "$ROOT/scenes/soft_shadows.pov" "$T/scene.pov"

@@ -85,6 +85,10 @@ static void test_words(void **state)
 	assert_true(gamma_of("#declare my_assumed_gamma = 2.4;") == 0.0);
 	assert_true(gamma_of("#declare assumed_gamma2 = 2.4;") == 0.0);
 	assert_false(focal_of("#declare aperture_size = 1; #declare my_blur_samples = 4;"));
+	/* a word character before the keyword too, with a number after it */
+	assert_true(gamma_of("#declare My_assumed_gamma 2.4") == 0.0);
+	assert_false(focal_of("#declare my_aperture = 1; camera { blur_samples 4 }"));
+	assert_false(focal_of("#declare Cam_aperture 0.4; camera { blur_samples 4 }"));
 }
 
 static void test_focal_blur(void **state)
@@ -124,6 +128,8 @@ static void test_read(void **state)
 	assert_int_equal(errno, ENOENT);
 	assert_int_equal(scene_read("/tmp", &k), -1);
 	assert_int_equal(errno, EISDIR);
+	assert_int_equal(scene_read("/dev/null", &k), -1);
+	assert_int_equal(errno, EINVAL);
 	assert_true(k.gamma == 1.0 && !k.radiosity && !k.aperture);
 }
 
