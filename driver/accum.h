@@ -68,6 +68,33 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * image's size, +R4).
  */
 #define ACC_AA_FIRST 16
+/*
+ * The cells such a render taken for a few pixels (highlights, stars: not
+ * for edges) stands for at a pixel POV-Ray subdivided: as for edges
+ * (ACC_AA_EDGE), the pixel takes the render as the cells its render
+ * pixels' colour distance says it was cut into, ramping from ACC_AA_FIRST
+ * where they agree to ACC_AA_FEW at the threshold, and is marked
+ * ACC_AA_DEEP there (scale 8's bit: after scale 4 such a pixel goes to 16,
+ * and finest_scale() counts it as 8, as an edge's).  ACC_AA_FIRST had been measured with the render at
+ * the image's size; at twice the size a highlight's subdivided render
+ * pixels are far nearer its truth than the later scales' regular grids,
+ * which alias it (hdr_highlights at 160x120: the render box-averaged has
+ * relMSE 1.1e-4, resolution scaling at 4 7.8e-4), and at 16 the grid at
+ * scale 4 pulled the lamps' reflections towards its aliasing (after pass 1
+ * 1.6e-4, after pass 2 2.4e-4).  Where the render pixels agree (a star
+ * between the corners, unseen) the weight stays ACC_AA_FIRST, so that a
+ * base sample holding the star still counts: a flat 256 left starfield at
+ * 1.8e-3 where 16 had 5.0e-4 to 6.4e-4.  By turns against a flat 16
+ * (scripts/abtest.sh, two runs each, 2026-12-04 01:18 UTC): hdr_highlights
+ * relMSE 0.26 to 0.61 times at targets 3e-3 to 1e-4 and budgets 2 to 8 s,
+ * starfield 0.33 to 0.93, still_life (edges) the same.  The cells are
+ * +R4's (ACC_AA_DEPTH); under a budget that takes +R3 (aa_depth()) the
+ * render was cut into a quarter as many, and its subdivided pixels weigh
+ * up to four times too much.
+ */
+#ifndef ACC_AA_FEW
+#define ACC_AA_FEW 256
+#endif
 
 /* The bit of the scale mask that marks an antialiased render in scale 2's
  * place (ACC_AA marks either kind; 5 is no scale). */
@@ -108,7 +135,8 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * their true error.  Not for the few-pixels rule's renders (starfield's
  * stars, hdr_highlights' lamps): a star between corners goes unseen, the
  * base sample may hold it, and there the same folding stopped starfield
- * at --target 3e-3 at relMSE 9.0e-3 on an estimate of 1.7e-4.
+ * at --target 3e-3 at relMSE 9.0e-3 on an estimate of 1.7e-4; only their
+ * weight and ACC_AA_DEEP are as for edges (ACC_AA_FEW).
  */
 #define ACC_AA_EDGE 7
 #define ACC_AA_DEEP 8

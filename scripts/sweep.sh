@@ -2,8 +2,9 @@
 # The benchmark: `povpress render` against POV-Ray alone, CPU time against
 # error, on the bundled scenes.  POV-Ray alone has two ways of adding samples
 # per pixel: its own antialiasing (+AM1, +AM2) and resolution scaling (render
-# at s*W x s*H with antialiasing off, box-average each s x s block); the
-# lower envelope of all its runs is the bar povpress must beat.
+# at s*W x s*H with antialiasing off, box-average each s x s block), and the
+# two together; the lower envelope of all its runs is the bar povpress must
+# beat.
 #
 # usage: scripts/sweep.sh [--quick] [--size WxH] [--repeat N] [--pov-repeat N]
 #                         [SCENE.pov ...]
@@ -48,6 +49,11 @@
 #             envelope stopped at scale 4, and povpress's dearer runs were
 #             measured against it, flattered: focal_blur at --budget 2 read
 #             0.46 against scale 4 and 1.08 against scale 6, README)
+#   aa2x      antialiasing at s = 2, box-averaged: +AM1 +A{0.1,0.03} +R3,
+#             +AM2 +A{0.3,0.1} +R3, +AM2 +A0.1 +R4, each +J (since
+#             2026-12-04: on hdr_highlights +AM2 +A0.1 +R4 so had relMSE
+#             1.1e-4 in 1.4 CPU s, where the envelope without it had 4.8e-4
+#             at that CPU; README)
 #   povpress  `povpress render` at --target 3e-3, 1e-3, 3e-4, 1e-4 and at
 #             --budget 2, 4, 8 seconds (with --target 1e-6), its defaults;
 #             each setting N times (--repeat N, 1 to 9; default 3, 1 with
@@ -59,8 +65,8 @@
 # but its CPU moved 10-20% between sweeps (soft_shadows' +AM2 +A0.01 +R4
 # 0.719 and 0.872 s), and where the envelope steps a povpress run's ratio
 # can jump 3-fold with it.
-# (--quick: thresholds 0.3, 0.03, 0.0, depths 2, 3, targets 3e-3 and 1e-3,
-# budget 3.)  Every POV-Ray run is one process,
+# (--quick: thresholds 0.3, 0.03, 0.0, depths 2, 3, at s = 2 +AM1 +A0.1 +R3
+# and +AM2 +A0.3 +R3, targets 3e-3 and 1e-3, budget 3.)  Every POV-Ray run is one process,
 #   povray -D -GA +FE +WT1 +W.. +H.. +O.. +I<scene> +L<scene's dir> [options]
 # with the paths in double quotes (POV-Ray splits unquoted ones at spaces).
 # Each run records the CPU seconds (user + system) and wall seconds of the
@@ -157,12 +163,14 @@ if ((quick)); then
 	REF_S=9 CHK_S=5 TRD_S=3
 	THRESHOLDS=(0.3 0.03 0.0)
 	DEPTHS=(2 3)
+	AA2X=("+AM1 +A0.1 +R3" "+AM2 +A0.3 +R3")
 	TARGETS=(3e-3 1e-3)
 	PP_BUDGETS=(3)
 else
 	REF_S=15 CHK_S=9 TRD_S=5
 	THRESHOLDS=(0.3 0.1 0.03 0.01 0.0)
 	DEPTHS=(2 3 4)
+	AA2X=("+AM1 +A0.1 +R3" "+AM1 +A0.03 +R3" "+AM2 +A0.3 +R3" "+AM2 +A0.1 +R3" "+AM2 +A0.1 +R4")
 	TARGETS=(3e-3 1e-3 3e-4 1e-4)
 	PP_BUDGETS=(2 4 8)
 fi
@@ -512,6 +520,9 @@ for m in 1 2; do
 		done
 	done
 done
+for a in "${AA2X[@]}"; do
+	runs+=("aa2x|$a|aa2x-$(tr -d ' +' <<<"$a")|$a +J")
+done
 for s in "${SCALES[@]}"; do
 	runs+=("scale|$s|scale$s|-A")
 done
@@ -534,6 +545,7 @@ for i in "${!scenes[@]}"; do
 		k=$((k + 1))
 		s=1
 		[[ $method == scale ]] && s=$setting
+		[[ $method == aa2x ]] && s=2
 		reps=$POV_REPEAT
 		[[ $method == povpress ]] && reps=$REPEAT
 		rows=()
@@ -612,7 +624,7 @@ for i in "${!scenes[@]}"; do
 	refdesc="$RSPP jittered samples per pixel"
 	[[ -z ${GAMMA[$sc]:-} ]] ||
 		refdesc="$RSPP samples per pixel, no antialiasing: assumed_gamma ${GAMMA[$sc]}"
-	for m in noaa am1 am2 scale; do
+	for m in noaa am1 am2 aa2x scale; do
 		awk -F, -v n="$name" -v m="$m" '$1 == n && $2 == m { print $4, $6, $3 }' \
 			"$CSV" >"$pd/$m.dat"
 	done
@@ -639,6 +651,7 @@ for i in "${!scenes[@]}"; do
 			'$pd/noaa.dat' using 1:2 with points pt 7 ps 1.6 lc rgb 'black' title 'no AA', \
 			'$pd/am1.dat' using 1:2 with points pt 6 ps 1.2 lc rgb '#1f77b4' title '+AM1', \
 			'$pd/am2.dat' using 1:2 with points pt 4 ps 1.2 lc rgb '#d62728' title '+AM2', \
+			'$pd/aa2x.dat' using 1:2 with points pt 8 ps 1.4 lc rgb '#ff7f0e' title 'AA at s=2', \
 			'$pd/scale.dat' using 1:2 with linespoints pt 9 ps 1.5 lc rgb '#2ca02c' title 'scaling s=${SCALES[0]}..${SCALES[-1]}', \\
 			'$pd/scale.dat' using 1:2:(sprintf('s=%d', \$3)) with labels offset 0,1.2 tc rgb '#2ca02c' notitle
 	EOF
@@ -672,7 +685,7 @@ summarize() {
 				ba = ""; bs = ""; sa = "-"; ss = "-"
 				for (j = 1; j <= cnt[sc]; j++) {
 					if (C[sc, j] > lim) continue
-					if (M[sc, j] ~ /^am/ && (ba == "" || R[sc, j] < ba)) {
+					if (M[sc, j] ~ /^(am|aa2x)/ && (ba == "" || R[sc, j] < ba)) {
 						ba = R[sc, j]; sa = M[sc, j] " " S[sc, j]
 					}
 					if (M[sc, j] == "scale" && (bs == "" || R[sc, j] < bs)) {
@@ -685,7 +698,7 @@ summarize() {
 			# the best AA run, and the best of the cheaper half of the AA runs
 			bo = ""; na = 0
 			for (j = 1; j <= cnt[sc]; j++)
-				if (M[sc, j] ~ /^am/) {
+				if (M[sc, j] ~ /^(am|aa2x)/) {
 					ac[++na] = C[sc, j]
 					if (bo == "" || R[sc, j] < bo) {
 						bo = R[sc, j]; bc = C[sc, j]; bset = M[sc, j] " " S[sc, j]
@@ -697,7 +710,7 @@ summarize() {
 				}
 			med = ac[int((na + 1) / 2)]; bh = ""
 			for (j = 1; j <= cnt[sc]; j++)
-				if (M[sc, j] ~ /^am/ && C[sc, j] <= med && (bh == "" || R[sc, j] < bh))
+				if (M[sc, j] ~ /^(am|aa2x)/ && C[sc, j] <= med && (bh == "" || R[sc, j] < bh))
 					bh = R[sc, j]
 			print line "\t" bo "\t" bc "\t" bset "\t" s1[sc] "\t" sm[sc] "\t" \
 				med "\t" bh
@@ -737,7 +750,8 @@ mode=full
 	echo "The reference is the scene at its default knobs at s = $REF_S times the size, every"
 	echo "pixel of that supersampled with \`${REF_AA[*]}\` ($((REF_SPP * REF_S * REF_S)) samples per pixel"
 	echo "after box-averaging); ref$CHK_S is the same at s = $CHK_S. Budgets are multiples of the no-AA run's CPU time; \"AA\" is"
-	echo "the best \`+AM1\`/\`+AM2\` run (thresholds ${THRESHOLDS[*]}, depths ${DEPTHS[*]}, \`+J\`)"
+	echo "the best \`+AM1\`/\`+AM2\` run (thresholds ${THRESHOLDS[*]}, depths ${DEPTHS[*]}, \`+J\`;"
+	echo "and at s = 2, box-averaged, \"AA at s=2\": $(printf '`%s`, ' "${AA2X[@]}" | sed 's/, $//'))"
 	echo "within the budget, \"scaling\" the best of s = ${SCALES[*]} within it (s = 1 is the"
 	echo "no-AA render); the winner column says by what factor it has the lower relMSE."
 	gs=()
