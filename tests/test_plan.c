@@ -723,6 +723,18 @@ static void test_merge_nonfinite(void **state)
 	image_release(&acc);
 }
 
+/* The cells an edge render's spread is divided over (ACC_AA_EDGE), as the
+ * header gives them: 1 up to a tenth of the threshold, `cells` from it,
+ * geometric between. */
+static double edge_cells_want(double range, double cells)
+{
+	if (range <= ACC_AA_THRESHOLD / 10.0)
+		return 1.0;
+	if (range >= ACC_AA_THRESHOLD)
+		return cells;
+	return pow(cells, log10(range / (ACC_AA_THRESHOLD / 10.0)));
+}
+
 /* 3b. An antialiased render (ACC_AA) is folded as the samples it proves to
  * be worth: n = sum A / sum D over the region, and per pixel at most its
  * own A / D (accum.c, aa_worth(), merge_aa()). */
@@ -840,13 +852,18 @@ static void test_merge_aa(void **state)
 	 * has one; and every pixel folded has scale 2 after it (planned at
 	 * scale 2 again, it would get the same render, which it refuses) */
 	make_acc(&acc, 4, 2, flat_value);
-	int bound = 0;
+	int bound = 0, heavier = 0, deeps = 0;
 	float *o3 = accpx(&acc, 3);
 	for (int c = 0; c < 3; c++)
 		o3[ACC_VAR_R + c] = (float)var[c];
 	o3[ACC_SAMPLES] = 9.0f;
 	accpx(&acc, 6)[ACC_SCALES] = (float)(1u << 1 | 1u << 4);
 	make_render(&big, 8, 0, 4, 2);
+	/* pixel 0's render pixels agree (a star between the corners would
+	 * look so): it keeps ACC_AA_FIRST */
+	for (int j = 0; j < 2; j++)
+		for (int l = 0; l < 2; l++)
+			memcpy(big.px + ((size_t)j * 8 + l) * 3, big.px, 3 * sizeof(float));
 	assert_int_equal(accum_merge_region(&acc, &big, 0, ACC_AA, 0, 0, 3, 1, 1, &folded, err,
 					    sizeof(err)), 0);
 	assert_int_equal(folded, 8);
@@ -855,17 +872,39 @@ static void test_merge_aa(void **state)
 		const float *o = accpx(&acc, (size_t)i);
 		assert_true(accum_has_scale(&acc, (size_t)i, 2));
 		assert_true(accum_has_scale(&acc, (size_t)i, ACC_AA_HALF));
-		assert_true(accum_next_scale(&acc, (size_t)i) == (i == 6 ? 8 : 4));
+		/* the colour distance of its 2 x 2 render pixels, as POV-Ray's
+		 * threshold measures it: the weight of a one-sample pixel ramps
+		 * from ACC_AA_FIRST to ACC_AA_FEW cells, and at the threshold
+		 * the pixel is marked subdivided (scale 8's bit) */
+		double range = 0.0;
+		for (int c = 0; c < 3; c++) {
+			double lo = INFINITY, hi = -INFINITY;
+			for (int j = 0; j < 2; j++)
+				for (int l = 0; l < 2; l++) {
+					const double t = render_at(&big, 0, 2 * x + l, 2 * y + j, c);
+					lo = t < lo ? t : lo;
+					hi = t > hi ? t : hi;
+				}
+			range += hi - lo;
+		}
+		const int deep = i != 3 && range >= ACC_AA_THRESHOLD;
+		deeps += deep;
+		assert_int_equal(accum_has_scale(&acc, (size_t)i, ACC_AA_DEEP), deep);
+		assert_true(accum_next_scale(&acc, (size_t)i) == (i == 6 ? (deep ? 16 : 8) : 4));
 		if (i == 3) {	/* 9 samples: weighed as before */
 			assert_true(o[ACC_SAMPLES] > 9.0f && o[ACC_SAMPLES] != 9.0f + ACC_AA_FIRST);
 			continue;
 		}
+		const double ef = edge_cells_want(range, ACC_AA_FEW);
+		const int kw = ef > ACC_AA_FIRST ? (int)lround(ef) : ACC_AA_FIRST;
+		if (kw > ACC_AA_FIRST)
+			heavier++;
 		double m = 0.0;
 		for (int j = 0; j < 2; j++)
 			for (int l = 0; l < 2; l++)
 				m += render_at(&big, 0, 2 * x + l, 2 * y + j, 0) / 4.0;
-		assert_true(o[ACC_SAMPLES] == (float)(1 + ACC_AA_FIRST));
-		assert_close(o[0], (flat_value(x, y, 0) + ACC_AA_FIRST * m) / (1 + ACC_AA_FIRST),
+		assert_true(o[ACC_SAMPLES] == (float)(1 + kw));
+		assert_close(o[0], (flat_value(x, y, 0) + kw * m) / (1 + kw),
 			     1e-6, 0.0, "the base sample and the 2 x 2 mean");
 		/* the new mean's error: the difference from the base sample
 		 * over the weights, but no more than the 2 x 2 mean's variance */
@@ -884,13 +923,14 @@ static void test_merge_aa(void **state)
 			d += (mc - flat_value(x, y, c)) * (mc - flat_value(x, y, c)) / den / 3.0;
 			v += vc / den / 3.0;
 		}
-		const double full = (ACC_AA_FIRST * ACC_AA_FIRST + 1.0) /
-				    ((1.0 + ACC_AA_FIRST) * (1.0 + ACC_AA_FIRST)) * d;
+		const double full = ((double)kw * kw + 1.0) / ((1.0 + kw) * (1.0 + kw)) * d;
 		assert_close(o[ACC_DIFF], full < v ? full : v, 1e-4, 1e-12,
 			     "the first fold's error: the difference, at most the 2 x 2 spread");
 		bound += v < full;
 	}
 	assert_true(bound > 0);	/* the spread bound acted somewhere */
+	assert_true(heavier > 0 && heavier < 7);	/* both weights were taken */
+	assert_true(deeps > 0);
 	image_release(&big);
 	image_release(&acc);
 
@@ -925,17 +965,6 @@ static double edge_strip(double v, double d, int s)
 	return e;
 }
 
-/* The cells an edge render's spread is divided over (ACC_AA_EDGE), as the
- * header gives them: 1 up to a tenth of the threshold, `cells` from it,
- * geometric between. */
-static double edge_cells_want(double range, double cells)
-{
-	if (range <= ACC_AA_THRESHOLD / 10.0)
-		return 1.0;
-	if (range >= ACC_AA_THRESHOLD)
-		return cells;
-	return pow(cells, log10(range / (ACC_AA_THRESHOLD / 10.0)));
-}
 
 /* 3c. An antialiased render in scale 2's place taken for edges at depth
  * d (4, ACC_AA_DEPTH, and 3): over a pixel's one sample it counts as
@@ -986,7 +1015,12 @@ static void test_merge_aa_edges(void **state)
 			assert_true(o[ACC_SAMPLES] == (float)(1 + k));
 			if (range >= ACC_AA_THRESHOLD)
 				assert_int_equal(k, cells);
-			assert_true(q[ACC_SAMPLES] == (float)(1 + ACC_AA_FIRST));
+			/* taken for a few pixels, the same ramp to ACC_AA_FEW */
+			const double ef = edge_cells_want(range, ACC_AA_FEW);
+			const int kf = ef > ACC_AA_FIRST ? (int)lround(ef) : ACC_AA_FIRST;
+			assert_true(q[ACC_SAMPLES] == (float)(1 + kf));
+			if (range >= ACC_AA_THRESHOLD)
+				assert_int_equal(kf, ACC_AA_FEW);
 			double d = 0.0, v = 0.0;
 			for (int c = 0; c < 3; c++) {
 				const double m = 0.4 + 0.1 * c;	/* the 2 x 2 mean */
@@ -1018,7 +1052,8 @@ static void test_merge_aa_edges(void **state)
 			assert_int_equal(accum_has_scale(&acc, (size_t)x, ACC_AA_DEEP),
 					 range >= ACC_AA_THRESHOLD);
 			assert_false(accum_has_scale(&plain, (size_t)x, ACC_AA_EDGE));
-			assert_false(accum_has_scale(&plain, (size_t)x, ACC_AA_DEEP));
+			assert_int_equal(accum_has_scale(&plain, (size_t)x, ACC_AA_DEEP),
+					 range >= ACC_AA_THRESHOLD);
 			assert_true(accum_has_scale(&plain, (size_t)x, ACC_AA_NOGRID));
 		}
 		if (depth < ACC_AA_DEPTH)
@@ -1721,7 +1756,8 @@ static double mixed_value(int x, int y, int c)
  * Edges a neighbour's samples already place.  A diagonal neighbour 0.6
  * brighter than the dark pixel 0 (3 x 3 pixels around, all 8 samples with
  * no spread): charged as a hidden edge while the two pixels beside both
- * are flat, not when either holds the step in its samples (a lamp's rim).
+ * are flat, not when either holds the step in its samples (a lamp's rim)
+ * or was subdivided by POV-Ray (ACC_AA_DEEP).
  * A one-sample pixel beside a pixel POV-Ray subdivided for an edge (its
  * mean 0.035 below, its samples' standard deviation 0.05): its range bound
  * counts the neighbour at the nearest of its mean +- that, here the pixel's
@@ -1760,8 +1796,14 @@ static void test_pixel_errors_edges(void **state)
 	/* the rim's spread too small to hold the step: charged again */
 	for (int c = 0; c < 3; c++)
 		accpx(&acc, 1)[ACC_VAR_R + c] = 0.01f * 0.01f;
-	assert_true(accum_pixel_error(&acc, 0, 1e-6, fit, accum_pixel_noise(&acc, 0, 0.0)) >
-		    0.5 * flat);
+	const double small = accum_pixel_error(&acc, 0, 1e-6, fit, accum_pixel_noise(&acc, 0, 0.0));
+	assert_true(small > 0.5 * flat);
+	/* ... unless POV-Ray subdivided the rim (ACC_AA_DEEP): the diagonal
+	 * step is in it, and only the smaller edge-on one is charged */
+	accpx(&acc, 1)[ACC_SCALES] = (float)(2 + 4 + 16 + (1u << ACC_AA_DEEP));
+	const double sub = accum_pixel_error(&acc, 0, 1e-6, fit, accum_pixel_noise(&acc, 0, 0.0));
+	assert_true(sub > 0.0 && sub < 0.5 * small);
+	accpx(&acc, 1)[ACC_SCALES] = 2 + 4 + 16;
 	/* the rim in the other pixel beside both, (0, 1), the same */
 	for (int c = 0; c < 3; c++) {
 		accpx(&acc, 1)[c] = 0.01f;
