@@ -52,7 +52,7 @@
 #   aa2x      antialiasing at s = 2, box-averaged: +AM1 +A{0.1,0.03} +R3,
 #             +AM2 +A{0.3,0.1} +R3, +AM2 +A0.1 +R4, each +J (since
 #             2026-12-04: on hdr_highlights +AM2 +A0.1 +R4 so had relMSE
-#             1.1e-4 in 1.4 CPU s, where the envelope without it had 4.8e-4
+#             1.1e-4 in 1.07 CPU s, where the envelope without it had 5.2e-4
 #             at that CPU; README)
 #   povpress  `povpress render` at --target 3e-3, 1e-3, 3e-4, 1e-4 and at
 #             --budget 2, 4, 8 seconds (with --target 1e-6), its defaults;
