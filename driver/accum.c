@@ -294,13 +294,12 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			const int half = f == ACC_GRID_FRAME;	/* in scale 2's place */
 			const int first = half && !(o[ACC_SAMPLES] >= 2.0f);
 			const int edge = half && edges;
-			const double ek = first && edge ? edge_cells(range, cells) : 1.0;
-			/* taken for a few pixels (highlights, stars), as the cells
-			 * the render pixels' colour distance says POV-Ray
-			 * subdivided the pixel into, as for edges (ACC_AA_FEW) */
-			const double ef = first && half && !edge ? edge_cells(range, ACC_AA_FEW) : 1.0;
-			const double eb = ek > ef ? ek : ef;
-			int k = first ? (eb > ACC_AA_FIRST ? (int)lround(eb) : ACC_AA_FIRST)
+			/* the cells its colour distance says POV-Ray subdivided
+			 * the pixel into, taken for edges or for a few pixels
+			 * (ACC_AA_FEW); only for edges is the spread over them */
+			const double ec = first ? edge_cells(range, edge ? cells : ACC_AA_FEW) : 1.0;
+			const double ek = edge ? ec : 1.0;
+			int k = first ? (ec > ACC_AA_FIRST ? (int)lround(ec) : ACC_AA_FIRST)
 				      : own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
 			/* taken for edges, the cells vary as the render pixels
 			 * do (v is their mean's variance): a shading ramp

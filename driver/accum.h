@@ -75,8 +75,9 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * pixels' colour distance says it was cut into, ramping from ACC_AA_FIRST
  * where they agree to ACC_AA_FEW at the threshold, and is marked
  * ACC_AA_DEEP there (scale 8's bit: after scale 4 such a pixel goes to 16,
- * and finest_scale() counts it as 8, as an edge's).  ACC_AA_FIRST had been measured with the render at
- * the image's size; at twice the size a highlight's subdivided render
+ * and finest_scale() counts it as 8, as an edge's).  ACC_AA_FIRST had been
+ * measured with the render at the image's size; at twice the size a
+ * highlight's subdivided render
  * pixels are far nearer its truth than the later scales' regular grids,
  * which alias it (hdr_highlights at 160x120: the render box-averaged has
  * relMSE 1.1e-4, resolution scaling at 4 7.8e-4), and at 16 the grid at
@@ -92,9 +93,7 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * render was cut into a quarter as many, and its subdivided pixels weigh
  * up to four times too much.
  */
-#ifndef ACC_AA_FEW
 #define ACC_AA_FEW 256
-#endif
 
 /* The bit of the scale mask that marks an antialiased render in scale 2's
  * place (ACC_AA marks either kind; 5 is no scale). */

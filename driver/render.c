@@ -24,7 +24,6 @@
 #include "driver/scene.h"
 #include "regression/lpr.h"
 
-#include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
 #include <limits.h>
@@ -2265,24 +2264,10 @@ bad:
 	char err[1024];
 	int ret = 1;
 	struct lpr_result res = {0};
-	struct stat st;
-	if (stat(r.scene, &st) || !S_ISREG(st.st_mode)) {
-		errbuf_printf(err, sizeof err, "cannot read scene '%s': %s", r.scene,
-			      errno ? strerror(errno) : "not a regular file");
-		if (!stat(r.scene, &st))
-			errbuf_printf(err, sizeof err, "cannot read scene '%s': not a regular file",
-				      r.scene);
-		goto fail_early;
-	}
-	if (access(r.scene, R_OK)) {
-		errbuf_printf(err, sizeof err, "cannot read scene '%s': %s", r.scene,
-			      strerror(errno));
-		goto fail_early;
-	}
 	struct scene_keys keys;
-	if (scene_read(r.scene, &keys)) {
+	if (scene_read(r.scene, &keys)) {	/* a regular file, readable */
 		errbuf_printf(err, sizeof err, "cannot read scene '%s': %s", r.scene,
-			      errno == EINVAL ? "not a regular file" : strerror(errno));
+			      scene_strerror(errno));
 		goto fail_early;
 	}
 	r.rad_named = keys.radiosity;

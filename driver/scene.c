@@ -96,6 +96,11 @@ int scene_read(const char *path, struct scene_keys *k)
 	return 0;
 }
 
+const char *scene_strerror(int e)
+{
+	return e == EINVAL ? "not a regular file" : strerror(e);
+}
+
 /*
  * Whether the scene file (not what it includes) names both of focal blur's
  * camera keywords, aperture (but for "aperture 0") and blur_samples,
@@ -195,7 +200,7 @@ int cmd_scene(int argc, char **argv)
 	struct scene_keys k;
 	if (scene_read(path, &k)) {
 		fprintf(stderr, "povpress scene: cannot read scene '%s': %s\n", path,
-			errno == EINVAL ? "not a regular file" : strerror(errno));
+			scene_strerror(errno));
 		return 1;
 	}
 	const double g = scene_assumed_gamma(&k);

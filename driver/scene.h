@@ -31,6 +31,10 @@ void scene_scan(const char *t, struct scene_keys *k);
  * that is not a regular one (*k then as scene_keys_init() leaves it). */
 int scene_read(const char *path, struct scene_keys *k);
 
+/* What scene_read()'s errno says, for a message: "not a regular file" for
+ * EINVAL, else strerror()'s text. */
+const char *scene_strerror(int e);
+
 /* Whether the file names both of focal blur's camera keywords, aperture
  * (but for "aperture 0") and blur_samples: render's --sampler auto then
  * scales frames up to 8 Mpixels before it turns to grid renders. */

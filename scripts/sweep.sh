@@ -668,6 +668,7 @@ done
 # render: a single measurement of a 0.05 s render is off by up to 25%.
 summarize() {
 	awk -F, -v budgets="${BUDGETS[*]}" -v smax="${SCALES[-1]}" '
+	function aa(m) { return m ~ /^(am|aa2x)/ }	# antialiasing, at s = 1 or 2
 	NR > 1 {
 		if (!($1 in seen)) { seen[$1] = 1; order[++ns] = $1 }
 		n = ++cnt[$1]; M[$1, n] = $2; S[$1, n] = $3; C[$1, n] = $4; R[$1, n] = $6
@@ -685,7 +686,7 @@ summarize() {
 				ba = ""; bs = ""; sa = "-"; ss = "-"
 				for (j = 1; j <= cnt[sc]; j++) {
 					if (C[sc, j] > lim) continue
-					if (M[sc, j] ~ /^(am|aa2x)/ && (ba == "" || R[sc, j] < ba)) {
+					if (aa(M[sc, j]) && (ba == "" || R[sc, j] < ba)) {
 						ba = R[sc, j]; sa = M[sc, j] " " S[sc, j]
 					}
 					if (M[sc, j] == "scale" && (bs == "" || R[sc, j] < bs)) {
@@ -698,7 +699,7 @@ summarize() {
 			# the best AA run, and the best of the cheaper half of the AA runs
 			bo = ""; na = 0
 			for (j = 1; j <= cnt[sc]; j++)
-				if (M[sc, j] ~ /^(am|aa2x)/) {
+				if (aa(M[sc, j])) {
 					ac[++na] = C[sc, j]
 					if (bo == "" || R[sc, j] < bo) {
 						bo = R[sc, j]; bc = C[sc, j]; bset = M[sc, j] " " S[sc, j]
@@ -710,7 +711,7 @@ summarize() {
 				}
 			med = ac[int((na + 1) / 2)]; bh = ""
 			for (j = 1; j <= cnt[sc]; j++)
-				if (M[sc, j] ~ /^(am|aa2x)/ && C[sc, j] <= med && (bh == "" || R[sc, j] < bh))
+				if (aa(M[sc, j]) && C[sc, j] <= med && (bh == "" || R[sc, j] < bh))
 					bh = R[sc, j]
 			print line "\t" bo "\t" bc "\t" bset "\t" s1[sc] "\t" sm[sc] "\t" \
 				med "\t" bh

@@ -380,18 +380,17 @@ EOF
 	--report "$T/gamma2.json" -- +WT1 || bad "gamma 2: render failed"
 check "gamma: the last gamma given as a number (2.0)" grep -q '"assumed_gamma": 2,' "$T/gamma2.json"
 scene_key() { "$PP" scene "$1" | sed -n "s/^$2: //p"; }
+# bundled KEY: "NAME.pov VALUE" for each bundled scene
+bundled() { for sc in "$SC"/*.pov; do echo "$(basename "$sc") $(scene_key "$sc" "$1")"; done; }
 check "scene: 1.8 where render reads 1.8" test "$(scene_key "$T/gamma.pov" assumed_gamma)" = 1.8
 check "scene: 1 where render reads 1" test "$(scene_key "$T/gamma1.pov" assumed_gamma)" = 1
 check "scene: 2 where render reads 2.0" test "$(scene_key "$T/gamma2.pov" assumed_gamma)" = 2
 check "scene: 2.2 in scenes/legacy_gamma.pov and no other gamma in the bundled scenes" \
-	test "$(for sc in "$SC"/*.pov; do echo "$(basename "$sc") $(scene_key "$sc" assumed_gamma)"; done |
-		awk '$2 != 1')" = "legacy_gamma.pov 2.2"
+	test "$(bundled assumed_gamma | awk '$2 != 1')" = "legacy_gamma.pov 2.2"
 check "scene: focal blur in scenes/focal_blur.pov alone" \
-	test "$(for sc in "$SC"/*.pov; do echo "$(basename "$sc") $(scene_key "$sc" focal_blur)"; done |
-		awk '$2 == "yes" { print $1 }')" = "focal_blur.pov"
+	test "$(bundled focal_blur | awk '$2 == "yes" { print $1 }')" = "focal_blur.pov"
 check "scene: radiosity named in scenes/radiosity_room.pov alone" \
-	test "$(for sc in "$SC"/*.pov; do echo "$(basename "$sc") $(scene_key "$sc" radiosity)"; done |
-		awk '$2 == "yes" { print $1 }')" = "radiosity_room.pov"
+	test "$(bundled radiosity | awk '$2 == "yes" { print $1 }')" = "radiosity_room.pov"
 
 # --- --sampler auto where the error sits in a few pixels: antialiasing first -
 # hdr_highlights' lamps and their reflections hold half the base pass's
