@@ -95,9 +95,10 @@ static const char usage_options[] =
 	"                        at K x the size on one thread for the radiosity\n"
 	"                        solution and keep its K x K samples per pixel (1, 2, 4\n"
 	"                        or 8; default: the smallest power of two making it\n"
-	"                        480+ pixels wide, at most 4, under a --budget\n"
-	"                        lowered (4, 3, 2) until the pass fits; 0: no such\n"
-	"                        pass)\n"
+	"                        480+ pixels wide, at most 4; under a --budget\n"
+	"                        the largest up to 1280 pixels wide and 8 when its\n"
+	"                        pass fits, else lowered (4, 3, 2) until it fits;\n"
+	"                        0: no such pass)\n"
 	"  --workdir DIR         keep intermediate files here (default OUT.exr.work)\n"
 	"  --keep-workdir        do not remove the work directory after success\n"
 	"  --resume              continue the run the work directory holds\n"
@@ -906,6 +907,38 @@ static int radiosity_scale(const struct run *r)
 	return k;
 }
 
+/*
+ * Under a budget, the frame may be larger still: up to 1280 pixels wide
+ * (8 at 160x120, 4 at 320x240, 2 at 640x480), taken by radiosity_pass()
+ * when its one-thread pass fits the budget.  The solution is the error
+ * region renders cannot remove, and the estimate does not see it: on
+ * radiosity_room at 160x120 the solution from 1280x960 left relMSE 6.6e-4
+ * under --budget 4 and 6.3e-4 under --budget 8 (2026-12-04),
+ * where runs with the one from 640x480 stop at 7.7e-4 whatever the budget
+ * (the sweep of 2026-12-04 01:33), and POV-Ray's scale 8 has 6.7e-4 in
+ * 3.0 CPU s.  Returns 0 when there is no larger frame to take.
+ */
+#define RAD_BIG_WIDTH 1280
+#define RAD_BIG_SCALE 8	/* and at most 8 times the image (the scales past
+			 * it the loop renders at next: up to 16) */
+/* The larger frame's pass is taken without RAD_MARGIN: on radiosity_room at
+ * 160x120 under --budget 4 (eight runs, 2026-12-04) it was predicted at 2.8
+ * to 2.9 s and took 2.6 to 2.8 s in the five that took it (relMSE 6.6e-4 to
+ * 6.7e-4, the runs ending by 3.9 s); in the other three the base pass's
+ * cost a sample, higher, predicted 4.2 to 4.4 s, and scale 4 ran (7.8e-4).
+ * With the margin it would not fit --budget 4 at all. */
+#define RAD_BIG_MARGIN 1.0
+static int radiosity_big(const struct run *r)
+{
+	if (r->budget <= 0.0 || r->user_rad_scale >= 0)
+		return 0;
+	const int k = radiosity_scale(r);
+	int big = k;
+	while (2 * big <= RAD_BIG_SCALE && 2 * big * r->w <= RAD_BIG_WIDTH)
+		big *= 2;
+	return big > k ? big : 0;
+}
+
 /* What the radiosity pass at scale k should take, wall seconds: by the
  * measured cost of a sample, not the plan's rounded one, which is up to
  * 1.4 times off either way (radiosity_room at 160x120, --budget 2: the
@@ -960,7 +993,18 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	 * whose image (1.63e-3 there) is a fair fallback, not the one from 3
 	 * to 2: scale 2's (3.6e-3) is more than twice POV-Ray's own scale 3 at
 	 * that CPU, and with the margin one run in six took it */
-	while (r->budget > 0.0 && r->user_rad_scale < 0 && k > 2 &&
+	const int big = radiosity_big(r);
+	int took_big = 0;
+	if (big > k) {
+		const double tbig = radiosity_time(r, big, 1);
+		if (elapsed(r) + RAD_BIG_MARGIN * tbig + after <= r->budget)
+			k = big, took_big = 1;
+		else if (r->verbose)
+			fprintf(stderr, "povpress render: radiosity pass not at scale %d: it would "
+				"take about %.1f s (pretrace %.2f s, %.3g s a sample), and %.1f s are left\n", big, tbig, r->pretrace_s, r->cost_sample_measured,
+				r->budget - elapsed(r) - after);
+	}
+	while (!took_big && r->budget > 0.0 && r->user_rad_scale < 0 && k > 2 &&
 	       elapsed(r) + (k > 3 ? RAD_MARGIN : 1.0) * radiosity_time(r, k, 1) + after >
 		       r->budget)
 		k--;	/* radiosity_scale() chooses at most 4 */
@@ -1201,8 +1245,9 @@ static void prelaunch_start(struct run *r, int pass, const struct pre_kind *kind
 /*
  * For a scene whose file mentions radiosity: the radiosity pass started
  * during the base pass, waiting at its gate, at each scale it may take
- * (radiosity_scale()'s, and under a budget the smaller ones down to 2 that
- * radiosity_pass() may fall back to; --radiosity-scale's alone).  The pass
+ * (radiosity_scale()'s, and under a budget radiosity_big()'s and the
+ * smaller ones down to 2 that radiosity_pass() may fall back to;
+ * --radiosity-scale's alone).  The pass
  * then begins from the gate, not from POV-Ray's start-up: on
  * radiosity_room at 160x120 under --budget 2 the run's scale-3 pass ended
  * its run at 1.92 to 2.20 s when it started afresh (see the README).  The
@@ -1215,10 +1260,11 @@ static void prelaunch_radiosity(struct run *r)
 	 * the scene has radiosity, and saves POV-Ray's start-up wait
 	 * (radiosity_room at 160x120, --target 3e-3: 1.99 to 2.15 s wall
 	 * against 2.23 to 2.34 s with --prelaunch off, the same image) */
-	if (!may_prelaunch_any(r) || top < 2)
+	const int big = radiosity_big(r);
+	if (!may_prelaunch_any(r) || (top < 2 && big < 2))
 		return;
 	const int low = r->user_rad_scale < 0 && r->budget > 0.0 ? 2 : top;
-	enum { NRAD = 3 };
+	enum { NRAD = 4 };
 	struct pov_job jobs[NRAD];
 	const size_t ne = r->nextra + 1;	/* frame_job() adds one */
 	const char **extras = calloc(NRAD * ne, sizeof(char *));
@@ -1227,6 +1273,11 @@ static void prelaunch_radiosity(struct run *r)
 	snprintf(rad, sizeof rad, "%s/radiosity-new.rca", r->workdir);
 	unsigned mask = 0;
 	size_t n = 0;
+	if (extras && big > top) {
+		frame_job(r, big, 1, out, rad, &jobs[n], extras + n * ne);
+		mask |= 1u << big;
+		n++;
+	}
 	for (int k = top; extras && k >= low && n < NRAD; k--, n++) {
 		frame_job(r, k, 1, out, rad, &jobs[n], extras + n * ne);
 		mask |= 1u << k;
@@ -1445,7 +1496,7 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	if (r->radiosity != (r->pre_rad != 0))
 		p.cpu_s += prelaunch_end(r);
 	int k = r->radiosity ? radiosity_scale(r) : 0, rrc = 0;
-	if (k > 1 || (k == 1 && r->cores > 1))
+	if (k > 1 || (k == 1 && r->cores > 1) || (k && radiosity_big(r) > k))
 		rrc = radiosity_pass(r, k, &p, err, errlen);
 	if (r->pre_rad) {	/* the scales not taken stop */
 		p.prelaunched = (int)pov_prelaunch_taken(r->pre);

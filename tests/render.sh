@@ -808,12 +808,20 @@ check "... the base pass's record counts it" \
 check "... no gate left in the work directory" test -z "$(find "$T/rp on" -name 'gate-*')"
 check "... no POV-Ray child left" no_povray_left "$T/rp on"
 check "... the output is a complete image" valid_exr "$T/rp-on.exr"
-check "... its radiosity pass ran at scale 4" grep -q '"radiosity_scale": 4' "$T/rp-on.json"
+check "... its radiosity pass ran at scale 8 (a frame 640 wide, which the budget fits)" \
+	grep -q '"radiosity_scale": 8' "$T/rp-on.json"
 check "radiosity under a budget, --prelaunch off: the run succeeds" test "$rprc_off" -eq 0
 check "... and no render was started early" \
 	test "$(grep -o '"prelaunched": [1-9]' "$T/rp-off.json" | wc -l)" -eq 0
 check "... the same image either way (one thread, the same solution)" \
 	test "$("$PP" compare "$T/rp-on.exr" "$T/rp-off.exr" | sed -n 's/^relmse: //p')" = 0
+# a sample costed at 2e-5 s: the pass at scale 8 (about 6 s) would not fit
+# the budget, and the one at the usual scale, 4 (about 1.5 s), does
+"$PP" render "$SC/radiosity_room.pov" -o "$T/r4.exr" -W 80 -H 60 --budget 4 --target 1e-6 \
+	--max-passes 0 --cost-sample 2e-5 --report "$T/r4.json" -v 2>"$T/r4.log"
+check "radiosity: a larger frame that would not fit the budget: the run succeeds" test $? -eq 0
+check "... it says why" grep -q "radiosity pass not at scale 8: it would take about" "$T/r4.log"
+check "... its radiosity pass ran at scale 4" grep -q '"radiosity_scale": 4' "$T/r4.json"
 # a radiosity pass that one thread would not finish within the budget (a
 # sample costed at 2.2e-4 s: scale 2 at 80x60 about 4.3 s of the 4) runs on
 # every core where that fits (about 2.5 s on two), else not at all; a
