@@ -258,7 +258,9 @@ static double edge_cells(double range, double cells)
 static long merge_aa(struct image *acc, const struct image *img, int oy, const int ch[3],
 		     int f, int x0, int y0, int x1, int y1, int pass, int edges)
 {
-	const int cells = edges ? accum_edge_cells(edges) : 0;
+	/* edges: the depth of a render taken for edges, or minus that of
+	 * one taken for a few pixels; 0 a few pixels at ACC_AA_DEPTH */
+	const int cells = accum_edge_cells(edges > 0 ? edges : edges < 0 ? -edges : ACC_AA_DEPTH);
 	int n = aa_worth(acc, img, oy, ch, f, x0, y0, x1, y1);
 	long count = 0;
 	for (int y = y0; y <= y1; y++)
@@ -293,11 +295,12 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			double own = worth_samples(&one);
 			const int half = f == ACC_GRID_FRAME;	/* in scale 2's place */
 			const int first = half && !(o[ACC_SAMPLES] >= 2.0f);
-			const int edge = half && edges;
+			const int edge = half && edges > 0;
 			/* the cells its colour distance says POV-Ray subdivided
 			 * the pixel into, taken for edges or for a few pixels
-			 * (ACC_AA_FEW); only for edges is the spread over them */
-			const double ec = first ? edge_cells(range, edge ? cells : ACC_AA_FEW) : 1.0;
+			 * (ACC_AA_FEW at +R4); only for edges is the spread over
+			 * them */
+			const double ec = first ? edge_cells(range, cells) : 1.0;
 			const double ek = edge ? ec : 1.0;
 			int k = first ? (ec > ACC_AA_FIRST ? (int)lround(ec) : ACC_AA_FIRST)
 				      : own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
@@ -855,6 +858,15 @@ int accum_merge_edge_region(struct image *acc, const struct image *img, int oy, 
 	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, depth, folded, err, errlen);
 }
 
+int accum_merge_few_region(struct image *acc, const struct image *img, int oy, int s,
+			   int depth, int x0, int y0, int x1, int y1, int pass, long *folded,
+			   char *err, size_t errlen)
+{
+	if (bad_depth(depth, err, errlen))
+		return -1;
+	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, -depth, folded, err, errlen);
+}
+
 static int merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
 		      int y1, int pass, int edges, long *folded, char *err, size_t errlen)
 {
@@ -1305,4 +1317,13 @@ void accum_noise_var(const struct image *acc, size_t i, double noise, double v[3
 		}
 		v[c] = isfinite(vs) && vs > 0.0 ? vs : 0.0;
 	}
+}
+
+int accum_merge_few_file(struct image *acc, const char *path, int s, int depth, int x0,
+			 int y0, int x1, int y1, int pass, long *folded, char *err,
+			 size_t errlen)
+{
+	if (bad_depth(depth, err, errlen))
+		return -1;
+	return merge_file(acc, path, s, x0, y0, x1, y1, pass, -depth, folded, err, errlen);
 }

@@ -89,9 +89,9 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * (scripts/abtest.sh, two runs each, 2026-12-04 01:18 UTC): hdr_highlights
  * relMSE 0.26 to 0.61 times at targets 3e-3 to 1e-4 and budgets 2 to 8 s,
  * starfield 0.33 to 0.93, still_life (edges) the same.  The cells are
- * +R4's (ACC_AA_DEPTH); under a budget that takes +R3 (aa_depth()) the
- * render was cut into a quarter as many, and its subdivided pixels weigh
- * up to four times too much.
+ * +R4's (ACC_AA_FEW); a render at +R3, which a budget may take
+ * (aa_depth()), was cut into a quarter as many, accum_edge_cells(3), and
+ * is merged by accum_merge_few_file() with its depth.
  */
 #define ACC_AA_FEW 256
 
@@ -288,6 +288,17 @@ int accum_merge_edge_region(struct image *acc, const struct image *img, int oy, 
 int accum_merge_edge_file(struct image *acc, const char *path, int s, int depth, int x0,
 			  int y0, int x1, int y1, int pass, long *folded, char *err,
 			  size_t errlen);
+
+/* The same for such a render taken for a few pixels (ACC_AA_FEW), at
+ * POV-Ray's depth `depth`: its subdivided pixels ramp to
+ * accum_edge_cells(depth) cells.  accum_merge_region() and
+ * accum_merge_file() take it as at ACC_AA_DEPTH. */
+int accum_merge_few_region(struct image *acc, const struct image *img, int oy, int s,
+			   int depth, int x0, int y0, int x1, int y1, int pass, long *folded,
+			   char *err, size_t errlen);
+int accum_merge_few_file(struct image *acc, const char *path, int s, int depth, int x0,
+			 int y0, int x1, int y1, int pass, long *folded, char *err,
+			 size_t errlen);
 
 /* What pixel i's relative errors are relative to: the mean over R, G, B
  * of value^2 + 0.01, the value being fit (the regression's, where finite;

@@ -2065,8 +2065,10 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		long folded = 0;
 		if (g->edges ? accum_merge_edge_file(&r->acc, outs[k], s, g->depth, g->x0, g->y0,
 						     g->x1, g->y1, pass, &folded, err, errlen)
-			     : accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1,
-						pass, &folded, err, errlen)) {
+		    : g->depth ? accum_merge_few_file(&r->acc, outs[k], s, g->depth, g->x0, g->y0,
+						      g->x1, g->y1, pass, &folded, err, errlen)
+			       : accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1,
+						  pass, &folded, err, errlen)) {
 			fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n", pass,
 				g->x0, g->y0, g->x1, g->y1, err);
 			p.failed++;

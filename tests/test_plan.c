@@ -979,7 +979,7 @@ static double edge_strip(double v, double d, int s)
  * threshold. */
 static void test_merge_aa_edges(void **state)
 {
-	struct image acc, big, plain;
+	struct image acc, big, plain, few;
 	char err[256];
 	long folded = -1;
 	/* per pixel of row 0, the spread of its 2 x 2 render pixels in each
@@ -1004,6 +1004,10 @@ static void test_merge_aa_edges(void **state)
 		assert_int_equal(accum_merge_edge_region(&acc, &big, 0, ACC_AA, depth, 0, 0, 4, 0,
 							 1, &folded, err, sizeof(err)), 0);
 		assert_int_equal(folded, 5);
+		make_acc(&few, 5, 1, flat_value);
+		assert_int_equal(accum_merge_few_region(&few, &big, 0, ACC_AA, depth, 0, 0, 4, 0,
+							1, &folded, err, sizeof(err)), 0);
+		assert_int_equal(folded, 5);
 		const int cells = accum_edge_cells(depth);
 		for (int x = 0; x < 5; x++) {
 			const float *o = accpx(&acc, (size_t)x), *q = accpx(&plain, (size_t)x);
@@ -1015,12 +1019,16 @@ static void test_merge_aa_edges(void **state)
 			assert_true(o[ACC_SAMPLES] == (float)(1 + k));
 			if (range >= ACC_AA_THRESHOLD)
 				assert_int_equal(k, cells);
-			/* taken for a few pixels, the same ramp to ACC_AA_FEW */
+			/* taken for a few pixels, the same ramp to ACC_AA_FEW
+			 * (+R4's cells), or at this depth to its cells */
 			const double ef = edge_cells_want(range, ACC_AA_FEW);
 			const int kf = ef > ACC_AA_FIRST ? (int)lround(ef) : ACC_AA_FIRST;
 			assert_true(q[ACC_SAMPLES] == (float)(1 + kf));
 			if (range >= ACC_AA_THRESHOLD)
 				assert_int_equal(kf, ACC_AA_FEW);
+			const float *fd = accpx(&few, (size_t)x);
+			assert_true(fd[ACC_SAMPLES] == (float)(1 + k));
+			assert_true(fd[ACC_SCALES] == q[ACC_SCALES]);
 			double d = 0.0, v = 0.0;
 			for (int c = 0; c < 3; c++) {
 				const double m = 0.4 + 0.1 * c;	/* the 2 x 2 mean */
@@ -1058,11 +1066,16 @@ static void test_merge_aa_edges(void **state)
 		}
 		if (depth < ACC_AA_DEPTH)
 			image_release(&acc);	/* the deepest goes on below */
+		image_release(&few);
 	}
 	for (int depth = 0; depth <= 5; depth += 5) {
 		err[0] = '\0';
 		assert_int_equal(accum_merge_edge_region(&acc, &big, 0, ACC_AA, depth, 0, 0, 4, 0,
 							 2, &folded, err, sizeof(err)), -1);
+		assert_non_null(strstr(err, "depth"));
+		err[0] = '\0';
+		assert_int_equal(accum_merge_few_region(&acc, &big, 0, ACC_AA, depth, 0, 0, 4, 0,
+							2, &folded, err, sizeof(err)), -1);
 		assert_non_null(strstr(err, "depth"));
 	}
 	image_release(&plain);
