@@ -252,14 +252,13 @@ static double edge_cells(double range, double cells)
 	return range >= ACC_AA_THRESHOLD ? cells : pow(cells, log10(range / lo));
 }
 
-/* Fold an antialiased render f times the image's size (see aa_worth()),
- * in scale 2's place taken for edges at POV-Ray's depth `edges` if that is
- * not 0 (ACC_AA_EDGE). */
+/* Fold an antialiased render f times the image's size (see aa_worth()).
+ * In scale 2's place, edges is POV-Ray's depth for a render taken for
+ * edges (ACC_AA_EDGE), minus the depth for one taken for a few pixels
+ * (ACC_AA_FEW), and 0 for one taken for a few pixels at ACC_AA_DEPTH. */
 static long merge_aa(struct image *acc, const struct image *img, int oy, const int ch[3],
 		     int f, int x0, int y0, int x1, int y1, int pass, int edges)
 {
-	/* edges: the depth of a render taken for edges, or minus that of
-	 * one taken for a few pixels; 0 a few pixels at ACC_AA_DEPTH */
 	const int cells = accum_edge_cells(edges > 0 ? edges : edges < 0 ? -edges : ACC_AA_DEPTH);
 	int n = aa_worth(acc, img, oy, ch, f, x0, y0, x1, y1);
 	long count = 0;

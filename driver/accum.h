@@ -150,6 +150,7 @@ static inline int accum_edge_cells(int d)
 {
 	return 1 << (2 * d);
 }
+_Static_assert(ACC_AA_FEW == 1 << (2 * ACC_AA_DEPTH), "ACC_AA_FEW is the cells at ACC_AA_DEPTH");
 #define ACC_AA_THRESHOLD 0.1
 
 /*

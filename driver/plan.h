@@ -119,7 +119,9 @@ struct plan_region {
 				 * 2's place (+A0.1 +R(depth) rather than +A0.0
 				 * +R4; render.c, choose_samplers()) */
 	int depth;		/* such a render's POV-Ray depth (+R, 1 to
-				 * ACC_AA_DEPTH; 0 for +R3) */
+				 * ACC_AA_DEPTH; 0 for +R3), by which it is
+				 * folded (accum_merge_few_file(), or
+				 * accum_merge_edge_file() for edges) */
 	int edges;		/* such a render taken for edges (render.c's
 				 * edge rule), folded so
 				 * (accum_merge_edge_file()) */

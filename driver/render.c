@@ -96,9 +96,9 @@ static const char usage_options[] =
 	"                        solution and keep its K x K samples per pixel (1, 2, 4\n"
 	"                        or 8; default: the smallest power of two making it\n"
 	"                        480+ pixels wide, at most 4; under a --budget\n"
-	"                        the largest up to 1280 pixels wide and 8 when its\n"
-	"                        pass fits, else lowered (4, 3, 2) until it fits;\n"
-	"                        0: no such pass)\n"
+	"                        a larger one when its pass fits on one thread (up\n"
+	"                        to 1280x960 pixels and 8 times the image), else\n"
+	"                        lowered (4, 3, 2) until it fits; 0: no such pass)\n"
 	"  --workdir DIR         keep intermediate files here (default OUT.exr.work)\n"
 	"  --keep-workdir        do not remove the work directory after success\n"
 	"  --resume              continue the run the work directory holds\n"
@@ -919,6 +919,7 @@ static int radiosity_scale(const struct run *r)
  * 3.0 CPU s.  Returns 0 when there is no larger frame to take.
  */
 #define RAD_BIG_WIDTH 1280
+#define RAD_BIG_PIXELS (1280.0 * 960.0)	/* and as many pixels (a tall image) */
 #define RAD_BIG_SCALE 8	/* and at most 8 times the image (the scales past
 			 * it the loop renders at next: up to 16) */
 /* The larger frame's pass is taken without RAD_MARGIN: on radiosity_room at
@@ -934,7 +935,8 @@ static int radiosity_big(const struct run *r)
 		return 0;
 	const int k = radiosity_scale(r);
 	int big = k;
-	while (2 * big <= RAD_BIG_SCALE && 2 * big * r->w <= RAD_BIG_WIDTH)
+	while (2 * big <= RAD_BIG_SCALE && 2 * big * r->w <= RAD_BIG_WIDTH &&
+	       4.0 * big * big * r->w * r->h <= RAD_BIG_PIXELS)
 		big *= 2;
 	return big > k ? big : 0;
 }
@@ -1001,9 +1003,13 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 			k = big, took_big = 1;
 		else if (r->verbose)
 			fprintf(stderr, "povpress render: radiosity pass not at scale %d: it would "
-				"take about %.1f s (pretrace %.2f s, %.3g s a sample), and %.1f s are left\n", big, tbig, r->pretrace_s, r->cost_sample_measured,
+				"take about %.1f s (pretrace %.2f s, %.3g s a sample), and %.1f s "
+				"are left\n", big, tbig, r->pretrace_s, r->cost_sample_measured,
 				r->budget - elapsed(r) - after);
 	}
+	/* at scale 1 on one core the pass would repeat the base pass */
+	if (!took_big && k == 1 && r->cores == 1)
+		return 0;
 	while (!took_big && r->budget > 0.0 && r->user_rad_scale < 0 && k > 2 &&
 	       elapsed(r) + (k > 3 ? RAD_MARGIN : 1.0) * radiosity_time(r, k, 1) + after >
 		       r->budget)
@@ -1011,7 +1017,9 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	int threads = 1;
 	double predicted = radiosity_time(r, k, 1);
 	const double room = r->budget - elapsed(r) - after;
-	if (r->budget > 0.0 && predicted > room) {
+	if (r->budget > 0.0 && predicted > room && !took_big) {
+		/* (the larger frame was found to fit on one thread a moment
+		 * ago: never on every core) */
 		/* on every core, when one would not do: the solution then
 		 * differs from run to run (below), but no pass leaves the
 		 * base pass's, computed on every core on the smallest frame

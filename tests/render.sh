@@ -854,6 +854,17 @@ check "... the output is a complete image" valid_exr "$T/rt.exr"
 	--report "$T/r1.json" -q 2>"$T/r1.err"
 check "radiosity at 480x360 (a radiosity pass at scale 1): the run succeeds" test $? -eq 0
 check "... the output is a complete image" valid_exr "$T/r1.exr"
+# on one core under a budget, with the larger frame (960x720) costed past the
+# budget and scale 1 within it: no pass at scale 1, which would repeat the
+# base pass (a sample costed at 2e-5 s: 960x720 about 14 s, 480x360 3.5 s)
+: >"$T/r1c.args"
+ARGS_LOG="$T/r1c.args" POVPRESS_POVRAY="$T/argpov" taskset -c 0 "$PP" render \
+	"$SC/radiosity_room.pov" -o "$T/r1c.exr" -W 480 -H 360 --budget 8 --target 1e-6 \
+	--max-passes 0 --cost-sample 2e-5 --prelaunch off -q 2>"$T/r1c.err"
+check "radiosity at 480x360 on one core under a budget: the run succeeds" test $? -eq 0
+check "... one render saved a radiosity solution: the base pass" \
+	test "$(grep -c -- '+W480 +H360 .*+RFO' "$T/r1c.args")" -eq 1
+check "... and none at 960x720" test "$(grep -c -- '+W960 +H720' "$T/r1c.args")" -eq 0
 # interrupted while the early renders wait at their gates
 "$PP" render "$SC/focal_blur.pov" -o "$T/pl-int.exr" -W $W -H $H --budget 5 --target 1e-6 \
 	--prelaunch on -q --workdir "$T/pl int" &

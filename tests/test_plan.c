@@ -1064,6 +1064,11 @@ static void test_merge_aa_edges(void **state)
 					 range >= ACC_AA_THRESHOLD);
 			assert_true(accum_has_scale(&plain, (size_t)x, ACC_AA_NOGRID));
 		}
+		/* at ACC_AA_DEPTH the few pixels' fold is the plain one in
+		 * every channel (samples, variance, difference, scales) */
+		if (depth == ACC_AA_DEPTH)
+			for (size_t i = 0; i < (size_t)5 * ACC_NCH; i++)
+				assert_true(memcmp(&few.px[i], &plain.px[i], sizeof(float)) == 0);
 		if (depth < ACC_AA_DEPTH)
 			image_release(&acc);	/* the deepest goes on below */
 		image_release(&few);
