@@ -252,14 +252,13 @@ static double edge_cells(double range, double cells)
 	return range >= ACC_AA_THRESHOLD ? cells : pow(cells, log10(range / lo));
 }
 
-/* Fold an antialiased render f times the image's size (see aa_worth()).
- * In scale 2's place, edges is POV-Ray's depth for a render taken for
- * edges (ACC_AA_EDGE), minus the depth for one taken for a few pixels
- * (ACC_AA_FEW), and 0 for one taken for a few pixels at ACC_AA_DEPTH. */
+/* Fold an antialiased render f times the image's size (see aa_worth()),
+ * in scale 2's place at POV-Ray's depth `depth` (0: ACC_AA_DEPTH), taken
+ * for edges (ACC_AA_EDGE) or else for a few pixels (ACC_AA_FEW). */
 static long merge_aa(struct image *acc, const struct image *img, int oy, const int ch[3],
-		     int f, int x0, int y0, int x1, int y1, int pass, int edges)
+		     int f, int x0, int y0, int x1, int y1, int pass, int depth, int edges)
 {
-	const int cells = accum_edge_cells(edges > 0 ? edges : edges < 0 ? -edges : ACC_AA_DEPTH);
+	const int cells = accum_edge_cells(depth ? depth : ACC_AA_DEPTH);
 	int n = aa_worth(acc, img, oy, ch, f, x0, y0, x1, y1);
 	long count = 0;
 	for (int y = y0; y <= y1; y++)
@@ -294,7 +293,7 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			double own = worth_samples(&one);
 			const int half = f == ACC_GRID_FRAME;	/* in scale 2's place */
 			const int first = half && !(o[ACC_SAMPLES] >= 2.0f);
-			const int edge = half && edges > 0;
+			const int edge = half && edges;
 			/* the cells its colour distance says POV-Ray subdivided
 			 * the pixel into, taken for edges or for a few pixels
 			 * (ACC_AA_FEW at +R4); only for edges is the spread over
@@ -720,8 +719,8 @@ static int render_rgb(const struct image *img, int ch[3], char *err, size_t errl
 }
 
 static int merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
-			int y0, int x1, int y1, int pass, int edges, long *folded, char *err,
-			size_t errlen)
+			int y0, int x1, int y1, int pass, int depth, int edges, long *folded,
+			char *err, size_t errlen)
 {
 	if (folded)
 		*folded = 0;
@@ -756,8 +755,9 @@ static int merge_region(struct image *acc, const struct image *img, int oy, int 
 	if (render_rgb(img, ch, err, errlen))
 		return -1;
 	if (s == ACC_AA || grid) {
-		long c = s == ACC_AA ? merge_aa(acc, img, oy, ch, f, x0, y0, x1, y1, pass, edges)
-				     : merge_grid(acc, img, oy, ch, s, x0, y0, x1, y1, pass);
+		long c = s == ACC_AA
+				 ? merge_aa(acc, img, oy, ch, f, x0, y0, x1, y1, pass, depth, edges)
+				 : merge_grid(acc, img, oy, ch, s, x0, y0, x1, y1, pass);
 		if (folded)
 			*folded = c;
 		return 0;
@@ -835,11 +835,11 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 		       int y0, int x1, int y1, int pass, long *folded, char *err,
 		       size_t errlen)
 {
-	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, 0, folded, err, errlen);
+	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, 0, 0, folded, err, errlen);
 }
 
-/* Whether depth is not one an antialiased render taken for edges may have
- * (the message in err). */
+/* Whether depth is not one an antialiased render in scale 2's place may
+ * have (the message in err). */
 static int bad_depth(int depth, char *err, size_t errlen)
 {
 	if (depth >= 1 && depth <= ACC_AA_DEPTH)
@@ -848,26 +848,19 @@ static int bad_depth(int depth, char *err, size_t errlen)
 	return 1;
 }
 
-int accum_merge_edge_region(struct image *acc, const struct image *img, int oy, int s,
-			    int depth, int x0, int y0, int x1, int y1, int pass, long *folded,
-			    char *err, size_t errlen)
+int accum_merge_aa_region(struct image *acc, const struct image *img, int oy, int s,
+			  int depth, int edges, int x0, int y0, int x1, int y1, int pass,
+			  long *folded, char *err, size_t errlen)
 {
 	if (bad_depth(depth, err, errlen))
 		return -1;
-	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, depth, folded, err, errlen);
-}
-
-int accum_merge_few_region(struct image *acc, const struct image *img, int oy, int s,
-			   int depth, int x0, int y0, int x1, int y1, int pass, long *folded,
-			   char *err, size_t errlen)
-{
-	if (bad_depth(depth, err, errlen))
-		return -1;
-	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, -depth, folded, err, errlen);
+	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, depth, edges, folded, err,
+			    errlen);
 }
 
 static int merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
-		      int y1, int pass, int edges, long *folded, char *err, size_t errlen)
+		      int y1, int pass, int depth, int edges, long *folded, char *err,
+		      size_t errlen)
 {
 	struct image img = {0};
 	int oy = 0;
@@ -880,7 +873,8 @@ static int merge_file(struct image *acc, const char *path, int s, int x0, int y0
 		f = render_frame(s, w, acc->w);
 	}
 	int rc = image_read_exr_rows(path, y0 * f, (y1 + 1) * f - 1, &img, &oy, err, errlen) ||
-		 merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, edges, folded, err, errlen);
+		 merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, depth, edges, folded, err,
+			      errlen);
 	image_release(&img);
 	return rc ? -1 : 0;
 }
@@ -888,16 +882,16 @@ static int merge_file(struct image *acc, const char *path, int s, int x0, int y0
 int accum_merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
 		     int y1, int pass, long *folded, char *err, size_t errlen)
 {
-	return merge_file(acc, path, s, x0, y0, x1, y1, pass, 0, folded, err, errlen);
+	return merge_file(acc, path, s, x0, y0, x1, y1, pass, 0, 0, folded, err, errlen);
 }
 
-int accum_merge_edge_file(struct image *acc, const char *path, int s, int depth, int x0,
-			  int y0, int x1, int y1, int pass, long *folded, char *err,
-			  size_t errlen)
+int accum_merge_aa_file(struct image *acc, const char *path, int s, int depth, int edges,
+			int x0, int y0, int x1, int y1, int pass, long *folded, char *err,
+			size_t errlen)
 {
 	if (bad_depth(depth, err, errlen))
 		return -1;
-	return merge_file(acc, path, s, x0, y0, x1, y1, pass, depth, folded, err, errlen);
+	return merge_file(acc, path, s, x0, y0, x1, y1, pass, depth, edges, folded, err, errlen);
 }
 
 /* The finest scale pixel i has been sampled at; an antialiased render of
@@ -1316,13 +1310,4 @@ void accum_noise_var(const struct image *acc, size_t i, double noise, double v[3
 		}
 		v[c] = isfinite(vs) && vs > 0.0 ? vs : 0.0;
 	}
-}
-
-int accum_merge_few_file(struct image *acc, const char *path, int s, int depth, int x0,
-			 int y0, int x1, int y1, int pass, long *folded, char *err,
-			 size_t errlen)
-{
-	if (bad_depth(depth, err, errlen))
-		return -1;
-	return merge_file(acc, path, s, x0, y0, x1, y1, pass, -depth, folded, err, errlen);
 }

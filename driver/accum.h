@@ -91,7 +91,7 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * starfield 0.33 to 0.93, still_life (edges) the same.  The cells are
  * +R4's (ACC_AA_FEW); a render at +R3, which a budget may take
  * (aa_depth()), was cut into a quarter as many, accum_edge_cells(3), and
- * is merged by accum_merge_few_file() with its depth.
+ * is merged by accum_merge_aa_file() with its depth.
  */
 #define ACC_AA_FEW 256
 
@@ -106,7 +106,7 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
 
 /*
  * The bits that mark a pixel folded from such a render taken for edges
- * (render.c's edge rule, accum_merge_edge_file()), and one the render
+ * (render.c's edge rule, accum_merge_aa_file()), and one the render
  * subdivided (its f x f render pixels differ by POV-Ray's threshold,
  * ACC_AA_THRESHOLD, or more).  At an edge the render's corners are half
  * a pixel apart and where they differ by the threshold POV-Ray
@@ -156,7 +156,7 @@ _Static_assert(ACC_AA_FEW == 1 << (2 * ACC_AA_DEPTH), "ACC_AA_FEW is the cells a
 /*
  * How many standard deviations of an edge render's pixel (its samples'
  * spread; after the render's fold onto the base sample, about its render
- * pixels', accum_merge_edge_file()) a step hidden inside it can be: one
+ * pixels', accum_merge_aa_file()) a step hidden inside it can be: one
  * render pixel of four apart by t gives a sample standard deviation (over
  * n - 1) of t / 2.  Their corners on the pixel's border are shared with
  * its neighbour, so a step between the two that this pixel's render pixels
@@ -279,27 +279,18 @@ int accum_split_diff(struct image *acc, const struct image *img, int s, char *er
 		     size_t errlen);
 
 /* accum_merge_region() and accum_merge_file() of an antialiased render in
- * scale 2's place (s ACC_AA, twice the image's size) taken for edges, at
- * POV-Ray's depth `depth` (+R, 1 to ACC_AA_DEPTH): folded as
- * ACC_AA_EDGE says, over accum_edge_cells(depth) cells.  Any other render
- * is folded as by the two. */
-int accum_merge_edge_region(struct image *acc, const struct image *img, int oy, int s,
-			    int depth, int x0, int y0, int x1, int y1, int pass, long *folded,
-			    char *err, size_t errlen);
-int accum_merge_edge_file(struct image *acc, const char *path, int s, int depth, int x0,
-			  int y0, int x1, int y1, int pass, long *folded, char *err,
-			  size_t errlen);
-
-/* The same for such a render taken for a few pixels (ACC_AA_FEW), at
- * POV-Ray's depth `depth`: its subdivided pixels ramp to
- * accum_edge_cells(depth) cells.  accum_merge_region() and
- * accum_merge_file() take it as at ACC_AA_DEPTH. */
-int accum_merge_few_region(struct image *acc, const struct image *img, int oy, int s,
-			   int depth, int x0, int y0, int x1, int y1, int pass, long *folded,
-			   char *err, size_t errlen);
-int accum_merge_few_file(struct image *acc, const char *path, int s, int depth, int x0,
-			 int y0, int x1, int y1, int pass, long *folded, char *err,
-			 size_t errlen);
+ * scale 2's place (s ACC_AA, twice the image's size) at POV-Ray's depth
+ * `depth` (+R, 1 to ACC_AA_DEPTH), its subdivided pixels taken as up to
+ * accum_edge_cells(depth) cells: taken for edges (edges not 0), folded as
+ * ACC_AA_EDGE says; else for a few pixels (ACC_AA_FEW).  Any other render
+ * is folded as by the two, which take such a render as for a few pixels at
+ * ACC_AA_DEPTH. */
+int accum_merge_aa_region(struct image *acc, const struct image *img, int oy, int s,
+			  int depth, int edges, int x0, int y0, int x1, int y1, int pass,
+			  long *folded, char *err, size_t errlen);
+int accum_merge_aa_file(struct image *acc, const char *path, int s, int depth, int edges,
+			int x0, int y0, int x1, int y1, int pass, long *folded, char *err,
+			size_t errlen);
 
 /* What pixel i's relative errors are relative to: the mean over R, G, B
  * of value^2 + 0.01, the value being fit (the regression's, where finite;

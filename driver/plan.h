@@ -120,11 +120,10 @@ struct plan_region {
 				 * +R4; render.c, choose_samplers()) */
 	int depth;		/* such a render's POV-Ray depth (+R, 1 to
 				 * ACC_AA_DEPTH; 0 for +R3), by which it is
-				 * folded (accum_merge_few_file(), or
-				 * accum_merge_edge_file() for edges) */
+				 * folded (accum_merge_aa_file()) */
 	int edges;		/* such a render taken for edges (render.c's
 				 * edge rule), folded so
-				 * (accum_merge_edge_file()) */
+				 * (accum_merge_aa_file()) */
 };
 
 /* Pixels in r. */

@@ -971,7 +971,8 @@ static double radiosity_time(const struct run *r, int k, int threads)
  * frame at scale k on one thread, antialiasing off, saving its radiosity
  * solution for the region renders.  Its k x k samples per pixel replace the base pass's
  * one (which was shaded with the coarser solution).  Returns 0 when done
- * or skipped (it would not end within the budget), -1 on failure,
+ * or skipped (it would not end within the budget, or at scale 1 on one core
+ * would repeat the base pass), -1 on failure,
  * POV_INTERRUPTED.
  */
 static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, size_t errlen)
@@ -1007,7 +1008,8 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 				"are left\n", big, tbig, r->pretrace_s, r->cost_sample_measured,
 				r->budget - elapsed(r) - after);
 	}
-	/* at scale 1 on one core the pass would repeat the base pass */
+	/* at scale 1 the pass repeats, on one thread, a base pass that ran on
+	 * several; on one core it would repeat it exactly */
 	if (!took_big && k == 1 && r->cores == 1)
 		return 0;
 	while (!took_big && r->budget > 0.0 && r->user_rad_scale < 0 && k > 2 &&
@@ -1497,14 +1499,12 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	p.pixels = (long)r->w * r->h;
 	p.samples = (double)r->w * r->h;
 	p.est_relmse = NAN;	/* filled in by the first analysis */
-	/* at scale 1 the radiosity pass only repeats a base pass that ran on
-	 * several threads */
 	/* early region renders would not load the solution; an early
 	 * radiosity pass serves only a scene that has radiosity */
 	if (r->radiosity != (r->pre_rad != 0))
 		p.cpu_s += prelaunch_end(r);
 	int k = r->radiosity ? radiosity_scale(r) : 0, rrc = 0;
-	if (k > 1 || (k == 1 && r->cores > 1) || (k && radiosity_big(r) > k))
+	if (k)
 		rrc = radiosity_pass(r, k, &p, err, errlen);
 	if (r->pre_rad) {	/* the scales not taken stop */
 		p.prelaunched = (int)pov_prelaunch_taken(r->pre);
@@ -1560,7 +1560,7 @@ static int has_scale2(const struct plan *pl)
  * twice (one_step(), choose_samplers()): a sort of w*h values, so kept in
  * *memo (-1 until asked) for the pass: SPARSE_FEW, SPARSE_EDGES (at edges
  * and not in a few pixels: the pass's antialiased renders are folded as
- * taken for edges, accum_merge_edge_file()) or 0. */
+ * taken for edges, accum_merge_aa_file()) or 0. */
 enum { SPARSE_FEW = 1, SPARSE_EDGES = 2 };
 static int sparse_error(const struct run *r, int *memo)
 {
@@ -2071,12 +2071,10 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			continue;
 		}
 		long folded = 0;
-		if (g->edges ? accum_merge_edge_file(&r->acc, outs[k], s, g->depth, g->x0, g->y0,
-						     g->x1, g->y1, pass, &folded, err, errlen)
-		    : g->depth ? accum_merge_few_file(&r->acc, outs[k], s, g->depth, g->x0, g->y0,
-						      g->x1, g->y1, pass, &folded, err, errlen)
-			       : accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1,
-						  pass, &folded, err, errlen)) {
+		if (g->depth ? accum_merge_aa_file(&r->acc, outs[k], s, g->depth, g->edges, g->x0,
+						   g->y0, g->x1, g->y1, pass, &folded, err, errlen)
+			     : accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1,
+						pass, &folded, err, errlen)) {
 			fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n", pass,
 				g->x0, g->y0, g->x1, g->y1, err);
 			p.failed++;

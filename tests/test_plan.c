@@ -1001,11 +1001,11 @@ static void test_merge_aa_edges(void **state)
 					    sizeof(err)), 0);
 	for (int depth = 3; depth <= 4; depth++) {
 		make_acc(&acc, 5, 1, flat_value);
-		assert_int_equal(accum_merge_edge_region(&acc, &big, 0, ACC_AA, depth, 0, 0, 4, 0,
+		assert_int_equal(accum_merge_aa_region(&acc, &big, 0, ACC_AA, depth, 1, 0, 0, 4, 0,
 							 1, &folded, err, sizeof(err)), 0);
 		assert_int_equal(folded, 5);
 		make_acc(&few, 5, 1, flat_value);
-		assert_int_equal(accum_merge_few_region(&few, &big, 0, ACC_AA, depth, 0, 0, 4, 0,
+		assert_int_equal(accum_merge_aa_region(&few, &big, 0, ACC_AA, depth, 0, 0, 0, 4, 0,
 							1, &folded, err, sizeof(err)), 0);
 		assert_int_equal(folded, 5);
 		const int cells = accum_edge_cells(depth);
@@ -1075,11 +1075,11 @@ static void test_merge_aa_edges(void **state)
 	}
 	for (int depth = 0; depth <= 5; depth += 5) {
 		err[0] = '\0';
-		assert_int_equal(accum_merge_edge_region(&acc, &big, 0, ACC_AA, depth, 0, 0, 4, 0,
+		assert_int_equal(accum_merge_aa_region(&acc, &big, 0, ACC_AA, depth, 1, 0, 0, 4, 0,
 							 2, &folded, err, sizeof(err)), -1);
 		assert_non_null(strstr(err, "depth"));
 		err[0] = '\0';
-		assert_int_equal(accum_merge_few_region(&acc, &big, 0, ACC_AA, depth, 0, 0, 4, 0,
+		assert_int_equal(accum_merge_aa_region(&acc, &big, 0, ACC_AA, depth, 0, 0, 0, 4, 0,
 							2, &folded, err, sizeof(err)), -1);
 		assert_non_null(strstr(err, "depth"));
 	}
