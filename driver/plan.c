@@ -1198,17 +1198,22 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 	}
 }
 
+/* The header line's start; the files before it ended with "scale output"
+ * and had no depth and edges columns (read as 0 0). */
+#define REGIONS_HEADER "# povpress regions: pass x0 y0 x1 y1 scale output depth edges"
+#define REGIONS_HEADER_V1 "# povpress regions: pass x0 y0 x1 y1 scale output"
+
 int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *outputs)
 {
-	fprintf(f, "# povpress regions: pass x0 y0 x1 y1 scale output (pixels 0-based, "
-		"inclusive)\n");
+	fprintf(f, "%s (pixels 0-based, inclusive; depth and edges: an antialiased render "
+		"in scale 2's place, its +R and 1 if taken for edges, else 0 0)\n", REGIONS_HEADER);
 	for (size_t k = 0; k < pl->nregions; k++)
 		if (strchr(outputs[k], '\n'))
 			return -1;	/* the format is one region per line */
 	for (size_t k = 0; k < pl->nregions; k++) {
 		const struct plan_region *r = &pl->regions[k];
-		fprintf(f, "%d\t%d\t%d\t%d\t%d\t%d\t%s\n", pass, r->x0, r->y0, r->x1, r->y1,
-			r->scale, outputs[k]);
+		fprintf(f, "%d\t%d\t%d\t%d\t%d\t%d\t%s\t%d\t%d\n", pass, r->x0, r->y0, r->x1,
+			r->y1, r->scale, outputs[k], r->depth, r->edges ? 1 : 0);
 	}
 	return ferror(f) ? -1 : 0;
 }
@@ -1236,13 +1241,39 @@ int plan_regions_save(const char *path, const struct plan *pl, int pass, char *c
 	return file_commit(f, tmp, path, err, errlen);
 }
 
+/* A region line's last two fields, depth and edges, into r, cut off s (the
+ * output and them); -1 if they are missing or out of range. */
+static int regions_tail(char *s, struct plan_region *r)
+{
+	char *t2 = strrchr(s, '\t');
+	if (!t2 || t2 == s)
+		return -1;
+	*t2 = '\0';
+	char *t1 = strrchr(s, '\t'), *end;
+	if (!t1 || t1 == s)
+		return -1;
+	*t1 = '\0';
+	errno = 0;
+	long d = strtol(t1 + 1, &end, 10);
+	if (end == t1 + 1 || *end || errno || d < 0 || d > ACC_AA_DEPTH)
+		return -1;
+	long e = strtol(t2 + 1, &end, 10);
+	if (end == t2 + 1 || *end || errno || (e != 0 && e != 1))
+		return -1;
+	if ((d || e) && (r->scale != ACC_AA || !d))
+		return -1;	/* only an antialiased render has them */
+	r->depth = (int)d;
+	r->edges = (int)e;
+	return 0;
+}
+
 int plan_regions_read(const char *path, struct plan_region **regions, char ***outputs,
 		      int **passes, size_t *n, char *err, size_t errlen)
 {
 	FILE *f = fopen(path, "r");
 	char line[8192];
 	size_t cnt = 0, alloc = 0;
-	int lineno = 0;
+	int lineno = 0, tail = 0;
 
 	*regions = NULL;
 	*outputs = NULL;
@@ -1257,15 +1288,22 @@ int plan_regions_read(const char *path, struct plan_region **regions, char ***ou
 		size_t len = strlen(line);
 		if (len && line[len - 1] == '\n')
 			line[--len] = '\0';
+		if (!strncmp(line, REGIONS_HEADER_V1, strlen(REGIONS_HEADER_V1)))
+			tail = !strncmp(line, REGIONS_HEADER, strlen(REGIONS_HEADER));
 		if (!len || line[0] == '#')
 			continue;
 		struct plan_region r = {0};
 		int pass, off = 0;
-		/* the output is everything after the sixth tab, spaces and all */
+		/* the output is everything after the sixth tab, spaces and all,
+		 * up to the last two tabs where the header names depth and edges */
 		if (sscanf(line, "%d\t%d\t%d\t%d\t%d\t%d%n", &pass, &r.x0, &r.y0, &r.x1, &r.y1,
-			   &r.scale, &off) != 6 || !off || line[off] != '\t' || !line[++off]) {
+			   &r.scale, &off) != 6 || !off || line[off] != '\t' || !line[++off] ||
+		    (tail && regions_tail(line + off, &r))) {
 			errbuf_printf(err, errlen, "'%s' line %d: expected \"pass x0 y0 x1 y1 scale "
-				      "output\" separated by tabs", path, lineno);
+				      "output%s\" separated by tabs%s", path, lineno,
+				      tail ? " depth edges" : "",
+				      tail ? " (depth 0 to 4, edges 0 or 1; 0 0 unless the scale "
+					     "is 0)" : "");
 			goto fail;
 		}
 		if (cnt == alloc) {

@@ -208,9 +208,13 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 
 /*
  * The regions file: a header line, then per region a tab-separated line
- * "pass x0 y0 x1 y1 scale output" (the output may hold any byte but a
- * newline; writing fails on one).  plan_regions_read() fills *regions (you
- * free() it and *outputs, an array of strings each to free()).
+ * "pass x0 y0 x1 y1 scale output depth edges" (the output may hold any
+ * byte but a newline; writing fails on one; depth and edges are the
+ * region's, 0 0 but for an antialiased render in scale 2's place).
+ * plan_regions_read() fills *regions (you free() it and *outputs, an array
+ * of strings each to free()); a file whose header line does not name depth
+ * and edges (written before they were recorded) has lines ending at the
+ * output, and its regions depth 0 and edges 0.
  */
 int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *outputs);
 /* The image region k of a pass renders to: DIR/pPP-rKKK-sS.exr. */

@@ -34,7 +34,8 @@ static const char plan_usage[] =
 	"  mask.exr      per pixel: samples (samples requested), scale (the resolution\n"
 	"                scale it is rendered at, 0: none), chosen (1 where the\n"
 	"                planner chose the pixel; rectangles also cover some others)\n"
-	"  regions.tsv   the packed rectangles: pass x0 y0 x1 y1 scale output\n"
+	"  regions.tsv   the packed rectangles: pass x0 y0 x1 y1 scale output depth\n"
+	"                edges (the last two 0 but for render's antialiased renders)\n"
 	"  jobs.txt      one complete povray command line per region, for sh,\n"
 	"                'xargs -P N -I{} sh -c {}' or GNU parallel\n"
 	"Then run the jobs and fold their images in with 'povpress merge'.\n"
@@ -85,11 +86,12 @@ static const char merge_usage[] =
 	"render (one sample per pixel).  R, G, B of an accumulation are the image.\n"
 	"A region of scale 0 is an antialiased render: at scale 1 (render --sampler\n"
 	"aa), folded as the samples it proves worth; or at twice the size (render's\n"
-	"auto in scale 2's place), a pixel with one sample taking it as the cells\n"
-	"POV-Ray cut it into (16 where its render pixels agree, up to 256 at +R4:\n"
-	"regions.tsv does not record a depth, and each is taken as +R4 and for a few\n"
-	"pixels, where render folds a +R3 render or one taken for edges its own way)\n"
-	"and every pixel as having had scale 2.\n"
+	"auto in scale 2's place, depth 3 or 4: its +R), a pixel with one sample\n"
+	"taking it as the cells POV-Ray cut it into (16 where its render pixels\n"
+	"agree, up to 64 at +R3 and 256 at +R4; taken for edges, edges 1, their\n"
+	"spread measures its noise) and every pixel as having had scale 2, as render\n"
+	"folds it.  A regions file without the depth and edges columns (before\n"
+	"povpress recorded them) has each such render taken as +R4 for a few pixels.\n"
 	"\n"
 	"options:\n"
 	"  -o, --output FILE   the new accumulation (may be ACCUM.exr itself)\n"
@@ -410,8 +412,11 @@ int cmd_merge(int argc, char **argv)
 			missing++;
 			continue;
 		}
-		if (accum_merge_file(&acc, outs[k], g->scale, g->x0, g->y0, g->x1, g->y1,
-				     passes[k], &folded, why, sizeof why)) {
+		if (g->depth ? accum_merge_aa_file(&acc, outs[k], g->scale, g->depth, g->edges,
+						   g->x0, g->y0, g->x1, g->y1, passes[k], &folded,
+						   why, sizeof why)
+			     : accum_merge_file(&acc, outs[k], g->scale, g->x0, g->y0, g->x1, g->y1,
+						passes[k], &folded, why, sizeof why)) {
 			errbuf_printf(err, sizeof err, "region %zu of '%s' (%s): %s", k + 1, regp,
 				      outs[k], why);
 			goto fail;

@@ -610,6 +610,51 @@ done
 check "... merge folds it to render's accumulation, bit for bit" \
 	idiff -fail 0 -failpercent 0 "$T/af-acc1-ch.exr" "$T/af.work-accum-ch.exr"
 
+# --- ... and one taken for edges, at +R4 and at +R3 (regions.tsv's depth and
+# edges columns), as render does; a file without them still merges ------------
+# still_life at 160x120 takes its first pass for edges; costing a sample at
+# 4e-5 s under a 4 s budget, +R3 (+R4 at 1e-5 s, +R3 from 2e-5 s by hand,
+# 2026-12-04)
+for n in r4 r3; do
+	o=()
+	[[ $n == r3 ]] && o=(--budget 4 --cost-job 0.05 --cost-sample 4e-5)
+	"$PP" render "$SC/still_life.pov" -o "$T/ae$n.exr" -W 160 -H 120 --jobs 1 --max-passes 1 \
+		-q "${o[@]}" --keep-workdir --workdir "$T/ae$n.work" -- +WT1 &&
+		"$PP" merge --init "$T/ae$n.work/base.exr" -o "$T/ae$n-acc0.exr" &&
+		"$PP" merge "$T/ae$n-acc0.exr" "$T/ae$n.work/regions.tsv" -o "$T/ae$n-acc1.exr" \
+			>/dev/null
+	check "still_life, one pass ($n): render, then merge its regions.tsv: runs" test $? -eq 0
+	check "... every region antialiased for edges at ${n/r/+R} (scale 0, depth ${n#r}, edges 1)" \
+		awk -F'\t' -v d="${n#r}" '!/^#/ { k++; if ($6 != 0 || $8 != d || $9 != 1) b = 1 }
+			END { exit b || !k }' "$T/ae$n.work/regions.tsv"
+	for f in "ae$n-acc1" "ae$n.work/accum"; do
+		oiiotool "$T/$f.exr" --ch R,G,B,samples,scales,diff,var.R -o "$T/${f//\//-}-ch.exr" \
+			2>/dev/null
+	done
+	check "... merge folds it to render's accumulation, bit for bit" \
+		idiff -fail 0 -failpercent 0 "$T/ae$n-acc1-ch.exr" "$T/ae$n.work-accum-ch.exr" >/dev/null
+done
+differ() { ! idiff -fail 0 -failpercent 0 "$@" >/dev/null; }
+# the same regions in the format before depth and edges: folded as +R4 for a few
+# pixels, which differs (so the columns are what made the fold above right)
+{
+	echo "# povpress regions: pass x0 y0 x1 y1 scale output (pixels 0-based, inclusive)"
+	grep -v '^#' "$T/aer3.work/regions.tsv" | cut -f1-7
+} >"$T/ae-old.tsv"
+"$PP" merge "$T/aer3-acc0.exr" "$T/ae-old.tsv" -o "$T/ae-old.exr" >/dev/null
+check "a regions file without depth and edges merges" test $? -eq 0
+oiiotool "$T/ae-old.exr" --ch R,G,B,samples,scales,diff,var.R -o "$T/ae-old-ch.exr" 2>/dev/null
+check "... as +R4 for a few pixels, not as render folded it" \
+	differ "$T/ae-old-ch.exr" "$T/aer3.work-accum-ch.exr"
+awk -F'\t' -v OFS='\t' '!/^#/ && !d++ { $8 = 5 } 1' "$T/aer3.work/regions.tsv" >"$T/ae-bad.tsv"
+fault "merge: a depth out of range: file and line named, no output" \
+	"ae-bad.tsv' line 2: expected \"pass x0 y0 x1 y1 scale output depth edges\"" \
+	"$T/ae-bad.exr" "$PP" merge "$T/aer3-acc0.exr" "$T/ae-bad.tsv" -o "$T/ae-bad.exr"
+awk -F'\t' -v OFS='\t' '!/^#/ && !d++ { $6 = 4 } 1' "$T/aer3.work/regions.tsv" >"$T/ae-bad.tsv"
+fault "merge: depth and edges on a scaled region: an error, no output" \
+	"ae-bad.tsv' line 2: expected" \
+	"$T/ae-bad.exr" "$PP" merge "$T/aer3-acc0.exr" "$T/ae-bad.tsv" -o "$T/ae-bad.exr"
+
 # --- a region job that crashes or hangs: retried, reported, image valid -----
 cat >"$T/fakepov" <<'EOF'
 #!/bin/sh

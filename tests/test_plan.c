@@ -2226,10 +2226,10 @@ static void test_regions_file(void **state)
 	struct plan_region rs[3] = {
 		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1, 0, 0, 0 },
 		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2, 0, 0, 0 },
-		{ 63, 47, 63, 47, 16, 1, 0.1, 0.3, 0, 0, 0 },
+		{ 63, 47, 63, 47, ACC_AA, 1, 0.1, 0.3, ACC_GRID_FRAME, 3, 1 },
 	};
 	static char o0[] = "r0.exr", o1[] = "a dir/with spaces/region 1.exr",
-		o2[] = "/tmp/x y  z.exr";
+		o2[] = "/tmp/x y\tz 4\t1.exr";
 	char *outs[3] = { o0, o1, o2 };
 	struct plan pl;
 	struct plan_region *got;
@@ -2256,6 +2256,8 @@ static void test_regions_file(void **state)
 		assert_int_equal(got[k].x1, rs[k].x1);
 		assert_int_equal(got[k].y1, rs[k].y1);
 		assert_int_equal(got[k].scale, rs[k].scale);
+		assert_int_equal(got[k].depth, rs[k].depth);
+		assert_int_equal(got[k].edges, rs[k].edges);
 		assert_string_equal(gout[k], outs[k]);
 		free(gout[k]);
 	}
@@ -2263,12 +2265,38 @@ static void test_regions_file(void **state)
 	free(gout);
 	free(passes);
 
-	/* line 3 has a letter for y0; then a line without an output */
+	/* a file from before depth and edges: its lines end at the output,
+	 * tabs and digits and all, and its regions have depth 0, edges 0 */
+	f = fopen(path, "w");
+	assert_non_null(f);
+	fputs("# povpress regions: pass x0 y0 x1 y1 scale output (pixels 0-based, inclusive)\n"
+	      "2\t1\t2\t3\t4\t0\tr 1\t4\t1\n", f);
+	assert_int_equal(fclose(f), 0);
+	assert_int_equal(plan_regions_read(path, &got, &gout, &passes, &n, err, sizeof(err)), 0);
+	assert_int_equal(n, 1);
+	assert_int_equal(got[0].scale, ACC_AA);
+	assert_int_equal(got[0].depth, 0);
+	assert_int_equal(got[0].edges, 0);
+	assert_string_equal(gout[0], "r 1\t4\t1");
+	free(gout[0]);
+	free(got);
+	free(gout);
+	free(passes);
+
+	/* line 3 has a letter for y0; then a line without an output; then,
+	 * under the header naming depth and edges, lines without them, with
+	 * a depth out of range, with edges on a scaled region, with edges 2 */
+#define HDR "# povpress regions: pass x0 y0 x1 y1 scale output depth edges\n"
 	static const char *const bad[] = {
 		"# header\n1\t0\t0\t3\t3\t2\ta.exr\n1\t0\tx\t3\t3\t2\tb.exr\n",
 		"# header\n\n1\t0\t0\t3\t3\t2\t\n",
+		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t1\n1\t0\t0\t3\t3\t2\tb.exr\n",
+		HDR "1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\t0\t3\t3\t0\tb.exr\t5\t0\n",
+		HDR "\n1\t0\t0\t3\t3\t2\ta.exr\t3\t1\n",
+		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t0\n1\t0\t0\t3\t3\t0\tb.exr\t4\t2\n",
 	};
-	for (int b = 0; b < 2; b++) {
+#undef HDR
+	for (int b = 0; b < 6; b++) {
 		f = fopen(path, "w");
 		assert_non_null(f);
 		fputs(bad[b], f);
