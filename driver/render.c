@@ -95,10 +95,12 @@ static const char usage_options[] =
 	"                        at K x the size on one thread for the radiosity\n"
 	"                        solution and keep its K x K samples per pixel (1, 2, 4\n"
 	"                        or 8; default: the smallest power of two making it\n"
-	"                        480+ pixels wide, at most 4; under a --budget\n"
-	"                        a larger one when its pass fits on one thread (up\n"
-	"                        to 1280x960 pixels and 8 times the image), else\n"
-	"                        lowered (4, 3, 2) until it fits; 0: no such pass)\n"
+	"                        1280+ pixels wide, at most 4 and 1280x960 pixels\n"
+	"                        (but 480+ wide); under a --budget: 480+ wide, at\n"
+	"                        most 4, or a larger one when its pass fits on one\n"
+	"                        thread (up to 1280 wide, 1280x960 pixels and 8\n"
+	"                        times the image), else lowered (4, 3, 2) until it\n"
+	"                        fits; 0: no such pass)\n"
 	"  --workdir DIR         keep intermediate files here (default OUT.exr.work)\n"
 	"  --keep-workdir        do not remove the work directory after success\n"
 	"  --resume              continue the run the work directory holds\n"
@@ -896,13 +898,33 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
  * (scripts/radiosity_solution.sh).  So the solution comes from the whole
  * frame scaled by the smallest power of two that makes it at least 480
  * pixels wide, at most 4.
+ *
+ * Without a budget, by the smallest that makes it at least RAD_TARGET_WIDTH
+ * wide, at most 4 and at most RAD_BIG_PIXELS: 4 at 160x120 as before, 4 at
+ * 320x240 (2 before), 2 at 640x480 (1 before).  The solution's error is a
+ * floor the region renders cannot take off, and a target run at those
+ * sizes lasts long enough for POV-Ray to render its frame at that scale
+ * whole: on radiosity_room at 320x240 the runs with 640x480's solution
+ * stopped at relMSE 1.5e-3 to 8.2e-4 in 1.3 to 7.8 CPU s (--target 3e-3
+ * to 1e-4), where POV-Ray's scale 4 had 3.7e-4 in 3.0 s; with 1280x960's
+ * they stopped at 3.7e-4 to 2.7e-4 in 3.8 to 5.3 s; at 640x480 (--target
+ * 3e-3 and 3e-4) 1.3e-3 and 1.0e-3 in 4.5 and 9.9 s with the frame's own
+ * solution, 7.1e-4 and 4.4e-4 in 4.8 and 7.6 s with 1280x960's, POV-Ray's
+ * scale 2 7.1e-4 in 3.2 s (one run each, 2026-12-04; see the README).
+ * Under a budget radiosity_big() takes the larger frame where it fits, and
+ * the smaller one stays the fallback.
  */
+#define RAD_TARGET_WIDTH 1280
+#define RAD_BIG_PIXELS (1280.0 * 960.0)	/* and as many pixels (a tall image) */
 static int radiosity_scale(const struct run *r)
 {
 	if (r->user_rad_scale >= 0)
 		return r->user_rad_scale;
 	int k = 1;
 	while (k < 4 && k * r->w < 480)
+		k *= 2;
+	while (r->budget <= 0.0 && k < 4 && k * r->w < RAD_TARGET_WIDTH &&
+	       4.0 * k * k * r->w * r->h <= RAD_BIG_PIXELS)
 		k *= 2;
 	return k;
 }
@@ -918,8 +940,7 @@ static int radiosity_scale(const struct run *r)
  * (the sweep of 2026-12-04 01:33), and POV-Ray's scale 8 has 6.7e-4 in
  * 3.0 CPU s.  Returns 0 when there is no larger frame to take.
  */
-#define RAD_BIG_WIDTH 1280
-#define RAD_BIG_PIXELS (1280.0 * 960.0)	/* and as many pixels (a tall image) */
+#define RAD_BIG_WIDTH 1280	/* and at most RAD_BIG_PIXELS */
 #define RAD_BIG_SCALE 8	/* and at most 8 times the image (the scales past
 			 * it the loop renders at next: up to 16) */
 /* The larger frame's pass is taken without RAD_MARGIN: on radiosity_room at

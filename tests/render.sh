@@ -893,12 +893,25 @@ else
 		test "$(grep -c -- '+W160 +H120 .*+RFO' "$T/rt.args")" -eq 0
 fi
 check "... the output is a complete image" valid_exr "$T/rt.exr"
-# at 480 pixels wide the radiosity pass is at scale 1, on one thread after a
-# base pass on every core (on one core there is none): a sample a pixel
+# a radiosity pass at scale 1, on one thread after a base pass on every core
+# (on one core there is none): a sample a pixel
 "$PP" render "$SC/radiosity_room.pov" -o "$T/r1.exr" -W 480 -H 360 --max-passes 0 \
-	--report "$T/r1.json" -q 2>"$T/r1.err"
+	--radiosity-scale 1 --report "$T/r1.json" -q 2>"$T/r1.err"
 check "radiosity at 480x360 (a radiosity pass at scale 1): the run succeeds" test $? -eq 0
 check "... the output is a complete image" valid_exr "$T/r1.exr"
+# without a budget the solution's frame is 1280 pixels wide or more, at most 4
+# times the image and 1280x960 pixels: 960x720 at 480x360, 1280x960 at
+# 320x240 (a wrapper logs the arguments; no region renders)
+for v in 480x360:960x720 320x240:1280x960; do
+	sz=${v%%:*} fr=${v#*:}
+	: >"$T/rs.args"
+	ARGS_LOG="$T/rs.args" POVPRESS_POVRAY="$T/argpov" "$PP" render "$SC/radiosity_room.pov" \
+		-o "$T/rs.exr" -W "${sz%x*}" -H "${sz#*x}" --max-passes 0 --prelaunch off -q \
+		2>"$T/rs.err"
+	check "radiosity at $sz, no budget: the run succeeds" test $? -eq 0
+	check "... its radiosity pass renders $fr on one thread, saving the solution" \
+		grep -q -- "+W${fr%x*} +H${fr#*x} +WT1 .*+RFO" "$T/rs.args"
+done
 # on one core under a budget, with the larger frame (960x720) costed past the
 # budget and scale 1 within it: no pass at scale 1, which would repeat the
 # base pass (a sample costed at 2e-5 s: 960x720 about 14 s, 480x360 3.5 s)
