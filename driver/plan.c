@@ -1390,6 +1390,21 @@ unsigned plan_error_where(const double *e, size_t n)
 	return where;
 }
 
+double plan_top_sum(const double *e, size_t n, double share)
+{
+	double *v = malloc(n * sizeof(*v));
+	if (!v)
+		return 0.0;
+	size_t k = 0;
+	for (size_t i = 0; i < n; i++)
+		if (isfinite(e[i]) && e[i] > 0.0)
+			v[k++] = e[i];
+	qsort(v, k, sizeof(*v), by_descending);
+	const double big = top_sum(v, k, n, share);
+	free(v);
+	return big;
+}
+
 int plan_sparse_error(const double *e, size_t n)
 {
 	return (plan_error_where(e, n) & PLAN_ERROR_FEW) != 0;

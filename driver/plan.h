@@ -264,6 +264,11 @@ int plan_sparse_error(const double *e, size_t n);
 #define PLAN_EDGE_FRAC 0.67
 int plan_edge_error(const double *e, size_t n);
 
+/* The sum of the largest share of the errors e (n pixels; at least one;
+ * values not finite or not positive left out): the top PLAN_EDGE_SHARE's
+ * for render.c's edge pass.  0 when memory runs out. */
+double plan_top_sum(const double *e, size_t n, double share);
+
 /* Both of the above from one sort of the errors: PLAN_ERROR_FEW if
  * plan_sparse_error(), PLAN_ERROR_EDGES if plan_edge_error(). */
 enum { PLAN_ERROR_FEW = 1u, PLAN_ERROR_EDGES = 2u };

@@ -655,6 +655,23 @@ fault "merge: depth and edges on a scaled region: an error, no output" \
 	"ae-bad.tsv' line 2: expected" \
 	"$T/ae-bad.exr" "$PP" merge "$T/aer3-acc0.exr" "$T/ae-bad.tsv" -o "$T/ae-bad.exr"
 
+# --- the edge pass takes the edges whole, even just above a loose target -----
+# still_life at 320x240: the base pass's estimate 4.4e-3; at --target 3e-3 the
+# pass planned for the target alone took 1342 pixels and left 4.2e-4 (by hand,
+# 2026-12-04), with the edges whole about 3.4e-6.  At --target 5e-3 the base
+# pass meets the target: no pass.
+det=(--cost-job 0.05 --cost-sample 4e-6 --jobs 1)
+"$PP" render "$SC/still_life.pov" -o "$T/ew.exr" -W 320 -H 240 --target 3e-3 --max-passes 1 \
+	"${det[@]}" --report "$T/ew.json" -v -- +WT1 2>"$T/ew.err"
+check "still_life at 320x240, --target 3e-3, one pass: runs" test $? -eq 0
+check "... its pass was antialiased for edges" grep -q "estimated error sits at edges" "$T/ew.err"
+check "... and took the edges whole: estimated relMSE below 3e-5 ($(jget "$T/ew.json" est_relmse))" \
+	num 'a < 3e-5' "$(jget "$T/ew.json" est_relmse)"
+"$PP" render "$SC/still_life.pov" -o "$T/ew5.exr" -W 320 -H 240 --target 5e-3 "${det[@]}" -q \
+	--report "$T/ew5.json" -- +WT1
+met_at_base() { grep -q '"stop": "target met"' "$1" && test "$(jget "$1" pass)" = 0; }
+check "... at --target 5e-3 the base pass meets it: no pass" met_at_base "$T/ew5.json"
+
 # --- a region job that crashes or hangs: retried, reported, image valid -----
 cat >"$T/fakepov" <<'EOF'
 #!/bin/sh

@@ -2220,6 +2220,27 @@ static void test_edge_error(void **state)
 	assert_false(plan_edge_error(f, 5));
 }
 
+/* 6d. plan_top_sum(): the sum of the largest share of the errors (at least
+ * one), what is not finite or not positive left out. */
+static void test_top_sum(void **state)
+{
+	enum { N = 200 };	/* 5% is 10 pixels */
+	double e[N];
+
+	(void)state;
+	for (int i = 0; i < N; i++)
+		e[i] = (double)(i + 1);	/* the largest ten: 191 to 200 */
+	assert_close(plan_top_sum(e, N, 0.05), 1955.0, 1e-12, 0.0, "the top 5%");
+	assert_close(plan_top_sum(e, N, 0.001), 200.0, 1e-12, 0.0, "at least one pixel");
+	assert_close(plan_top_sum(e, N, 1.0), 20100.0, 1e-12, 0.0, "all of them");
+	for (int i = 0; i < N; i++)
+		e[i] = i % 4 == 0 ? NAN : i % 4 == 1 ? -5.0 : i % 4 == 2 ? INFINITY : 0.0;
+	assert_close(plan_top_sum(e, N, 0.05), 0.0, 0.0, 0.0, "nothing left");
+	e[3] = 2.0;
+	e[7] = 3.0;
+	assert_close(plan_top_sum(e, N, 0.05), 5.0, 1e-12, 0.0, "the two that count");
+}
+
 /* 7. The regions file round-trips; a bad line is reported with its number. */
 static void test_regions_file(void **state)
 {
@@ -2500,6 +2521,7 @@ int main(void)
 		cmocka_unit_test(test_final_choice),
 		cmocka_unit_test(test_sparse_error),
 		cmocka_unit_test(test_edge_error),
+		cmocka_unit_test(test_top_sum),
 		cmocka_unit_test(test_regions_file),
 		cmocka_unit_test(test_plan_job),
 	};
