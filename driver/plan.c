@@ -8,6 +8,7 @@
 #include "driver/metrics.h"
 #include "driver/parallel.h"
 
+#include <ctype.h>
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -1198,6 +1199,10 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 	}
 }
 
+#define STR_(x) #x
+#define STR(x) STR_(x)
+#define ACC_AA_DEPTH_STR STR(ACC_AA_DEPTH)
+
 /* The header line's start; the files before it ended with "scale output"
  * and had no depth and edges columns (read as 0 0). */
 #define REGIONS_HEADER "# povpress regions: pass x0 y0 x1 y1 scale output depth edges"
@@ -1253,12 +1258,14 @@ static int regions_tail(char *s, struct plan_region *r)
 	if (!t1 || t1 == s)
 		return -1;
 	*t1 = '\0';
+	if (!isdigit((unsigned char)t1[1]) || !isdigit((unsigned char)t2[1]))
+		return -1;	/* no sign or space */
 	errno = 0;
 	long d = strtol(t1 + 1, &end, 10);
-	if (end == t1 + 1 || *end || errno || d < 0 || d > ACC_AA_DEPTH)
+	if (*end || errno || d > ACC_AA_DEPTH)
 		return -1;
 	long e = strtol(t2 + 1, &end, 10);
-	if (end == t2 + 1 || *end || errno || (e != 0 && e != 1))
+	if (*end || errno || (e != 0 && e != 1))
 		return -1;
 	if ((d || e) && (r->scale != ACC_AA || !d))
 		return -1;	/* only an antialiased render has them */
@@ -1273,7 +1280,7 @@ int plan_regions_read(const char *path, struct plan_region **regions, char ***ou
 	FILE *f = fopen(path, "r");
 	char line[8192];
 	size_t cnt = 0, alloc = 0;
-	int lineno = 0, tail = 0;
+	int lineno = 0, tail = 1;	/* but under the old header */
 
 	*regions = NULL;
 	*outputs = NULL;
@@ -1288,6 +1295,8 @@ int plan_regions_read(const char *path, struct plan_region **regions, char ***ou
 		size_t len = strlen(line);
 		if (len && line[len - 1] == '\n')
 			line[--len] = '\0';
+		if (len && line[len - 1] == '\r')
+			line[--len] = '\0';	/* a file edited elsewhere */
 		if (!strncmp(line, REGIONS_HEADER_V1, strlen(REGIONS_HEADER_V1)))
 			tail = !strncmp(line, REGIONS_HEADER, strlen(REGIONS_HEADER));
 		if (!len || line[0] == '#')
@@ -1302,8 +1311,8 @@ int plan_regions_read(const char *path, struct plan_region **regions, char ***ou
 			errbuf_printf(err, errlen, "'%s' line %d: expected \"pass x0 y0 x1 y1 scale "
 				      "output%s\" separated by tabs%s", path, lineno,
 				      tail ? " depth edges" : "",
-				      tail ? " (depth 0 to 4, edges 0 or 1; 0 0 unless the scale "
-					     "is 0)" : "");
+				      tail ? " (depth 0 to " ACC_AA_DEPTH_STR ", edges 0 or 1; 0 0 "
+					     "unless the scale is 0)" : "");
 			goto fail;
 		}
 		if (cnt == alloc) {

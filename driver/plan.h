@@ -212,9 +212,10 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
  * byte but a newline; writing fails on one; depth and edges are the
  * region's, 0 0 but for an antialiased render in scale 2's place).
  * plan_regions_read() fills *regions (you free() it and *outputs, an array
- * of strings each to free()); a file whose header line does not name depth
- * and edges (written before they were recorded) has lines ending at the
- * output, and its regions depth 0 and edges 0.
+ * of strings each to free()); a file whose header line is the old one,
+ * ending at "output" (written before depth and edges were recorded), has
+ * lines ending at the output, and its regions depth 0 and edges 0; any
+ * other file's lines end in depth and edges.
  */
 int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *outputs);
 /* The image region k of a pass renders to: DIR/pPP-rKKK-sS.exr. */

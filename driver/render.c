@@ -905,12 +905,13 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
  * floor the region renders cannot take off, and a target run at those
  * sizes lasts long enough for POV-Ray to render its frame at that scale
  * whole: on radiosity_room at 320x240 the runs with 640x480's solution
- * stopped at relMSE 1.5e-3 to 8.2e-4 in 1.3 to 7.8 CPU s (--target 3e-3
- * to 1e-4), where POV-Ray's scale 4 had 3.7e-4 in 3.0 s; with 1280x960's
- * they stopped at 3.7e-4 to 2.7e-4 in 3.8 to 5.3 s; at 640x480 (--target
- * 3e-3 and 3e-4) 1.3e-3 and 1.0e-3 in 4.5 and 9.9 s with the frame's own
- * solution, 7.1e-4 and 4.4e-4 in 4.8 and 7.6 s with 1280x960's, POV-Ray's
- * scale 2 7.1e-4 in 3.2 s (one run each, 2026-12-04; see the README).
+ * stopped at relMSE 1.6e-3 to 8.8e-4 in 1.1 to 6.1 CPU s (--target 3e-3
+ * to 1e-4), where POV-Ray's scale 4 has 5.0e-4 in 3.0 s; with 1280x960's
+ * at 5.0e-4 to 4.1e-4 in 3.4 to 4.7 s; at 640x480 (--target 3e-3 and
+ * 3e-4) 1.2e-3 and 9.5e-4 in 3.1 and 8.2 s became 7.3e-4 and 4.9e-4 in
+ * 4.1 and 6.9 s, POV-Ray's scale 2 7.3e-4 in 3.6 s (against a render
+ * of 3840x2880 on one thread, 2026-12-04; the README, *Scene
+ * consistency*, says how uncertain such references are).
  * Under a budget radiosity_big() takes the larger frame where it fits, and
  * the smaller one stays the fallback.
  */
@@ -1578,10 +1579,10 @@ static int has_scale2(const struct plan *pl)
  * base pass of a scene with neither radiosity (whose error is its
  * solution's) nor focal blur (where antialiasing's samples are worth a
  * quarter of scaling's), at edges (plan_error_where()).  A pass may ask
- * twice (one_step(), choose_samplers()): a sort of w*h values, so kept in
- * *memo (-1 until asked) for the pass: SPARSE_FEW, SPARSE_EDGES (at edges
- * and not in a few pixels: the pass's antialiased renders are folded as
- * taken for edges, accum_merge_aa_file()) or 0. */
+ * three times (one_step(), edge_target(), choose_samplers()): a sort of
+ * w*h values, so kept in *memo (-1 until asked) for the pass: SPARSE_FEW,
+ * SPARSE_EDGES (at edges and not in a few pixels: the pass's antialiased
+ * renders are folded as taken for edges, accum_merge_aa_file()) or 0. */
 enum { SPARSE_FEW = 1, SPARSE_EDGES = 2 };
 static int sparse_error(const struct run *r, int *memo)
 {
@@ -1880,15 +1881,15 @@ static void learn_costs(struct run *r, const struct plan_params *pp, const struc
  * edges (sparse_error(): its antialiased render in scale 2's place), no
  * budget set and the base pass's estimate above the target: at most what
  * is left once EDGE_TAKE of the top PLAN_EDGE_SHARE of the pixels' error
- * is taken off, so that the pass takes the edges whole.  The planner
- * prices that render as scale 2's four samples, taking a quarter of a
- * pixel's error, where at an edge it takes nearly all of it: planned for
- * the target alone, a base pass just above it got a few edges and stopped
- * (still_life at 320x240, --target 3e-3: the base pass's estimate 4.4e-3,
- * 1342 pixels chosen, relMSE 2.6e-4 in 1.8 CPU s, 13 times POV-Ray's best
- * at that CPU (`+AM2 +A0.3 +R3` at twice the size, 1.7e-5 in 1.2 s; the
- * quick sweep at 320x240 of 2026-12-04 10:06); with the rule 5662 chosen,
- * 1.8e-6 in 2.6 s, as at --target 1e-3.  Debian's lights/arealit3 there:
+ * is taken off, so that the pass takes the edges whole.  Planned for the
+ * target alone, the pass takes just enough of the dearest pixels for its
+ * prediction to reach a share of the target (plan_params' margin), and a
+ * base pass whose estimate stood just above a loose target got a few
+ * edges and stopped (still_life at 320x240, --target 3e-3: the base pass's
+ * estimate 4.4e-3, 1342 pixels chosen, relMSE 2.3e-4 in 1.8 CPU s in the
+ * quick sweep at 320x240 of 2026-12-04 10:06, 13 times POV-Ray's best at
+ * that CPU, `+AM2 +A0.3 +R3` at twice the size, 1.7e-5 in 1.2 s; 2.6e-4 by
+ * hand); with the rule 5662 chosen, 1.8e-6 in 2.6 s, as at --target 1e-3.  Debian's lights/arealit3 there:
  * 9.3e-5 and 1.5e-4 in 1.9 s (1.9 and 3.1 times POV-Ray's `+AM2 +A0.1 +R3`,
  * 4.9e-5 in 0.83 s) became 1.6e-5 in 5.1 s (1.02 times `+AM2 +A0.1 +R4` at
  * twice the size, 1.5e-5 in 3.7 s).  Deterministic runs of the bundled
@@ -1909,7 +1910,12 @@ static double edge_target(const struct run *r, int *sparse)
 	if (!(all / (double)n > r->target))
 		return r->target;	/* met: no pass */
 	const double t = (all - EDGE_TAKE * plan_top_sum(r->est, n, PLAN_EDGE_SHARE)) / (double)n;
-	return t > 0.0 && t < r->target ? t : r->target;
+	if (!(t > 0.0 && t < r->target))
+		return r->target;
+	if (r->verbose)
+		fprintf(stderr, "povpress render: pass 1 plans for an estimated relMSE of %.3g, "
+			"the edges whole, below the target\n", t);
+	return t;
 }
 
 /*

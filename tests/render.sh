@@ -665,6 +665,8 @@ det=(--cost-job 0.05 --cost-sample 4e-6 --jobs 1)
 	"${det[@]}" --report "$T/ew.json" -v -- +WT1 2>"$T/ew.err"
 check "still_life at 320x240, --target 3e-3, one pass: runs" test $? -eq 0
 check "... its pass was antialiased for edges" grep -q "estimated error sits at edges" "$T/ew.err"
+check "... and planned for the edges whole, below the target" \
+	grep -q "pass 1 plans for an estimated relMSE of .*, the edges whole" "$T/ew.err"
 check "... and took the edges whole: estimated relMSE below 3e-5 ($(jget "$T/ew.json" est_relmse))" \
 	num 'a < 3e-5' "$(jget "$T/ew.json" est_relmse)"
 "$PP" render "$SC/still_life.pov" -o "$T/ew5.exr" -W 320 -H 240 --target 5e-3 "${det[@]}" -q \

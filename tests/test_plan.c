@@ -2290,8 +2290,8 @@ static void test_regions_file(void **state)
 	 * tabs and digits and all, and its regions have depth 0, edges 0 */
 	f = fopen(path, "w");
 	assert_non_null(f);
-	fputs("# povpress regions: pass x0 y0 x1 y1 scale output (pixels 0-based, inclusive)\n"
-	      "2\t1\t2\t3\t4\t0\tr 1\t4\t1\n", f);
+	fputs("# povpress regions: pass x0 y0 x1 y1 scale output (pixels 0-based, inclusive)\r\n"
+	      "2\t1\t2\t3\t4\t0\tr 1\t4\t1\r\n", f);
 	assert_int_equal(fclose(f), 0);
 	assert_int_equal(plan_regions_read(path, &got, &gout, &passes, &n, err, sizeof(err)), 0);
 	assert_int_equal(n, 1);
@@ -2309,15 +2309,18 @@ static void test_regions_file(void **state)
 	 * a depth out of range, with edges on a scaled region, with edges 2 */
 #define HDR "# povpress regions: pass x0 y0 x1 y1 scale output depth edges\n"
 	static const char *const bad[] = {
-		"# header\n1\t0\t0\t3\t3\t2\ta.exr\n1\t0\tx\t3\t3\t2\tb.exr\n",
-		"# header\n\n1\t0\t0\t3\t3\t2\t\n",
+		"# header\n1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\tx\t3\t3\t2\tb.exr\t0\t0\n",
+		"# header\n\n1\t0\t0\t3\t3\t2\t\t0\t0\n",
 		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t1\n1\t0\t0\t3\t3\t2\tb.exr\n",
 		HDR "1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\t0\t3\t3\t0\tb.exr\t5\t0\n",
 		HDR "\n1\t0\t0\t3\t3\t2\ta.exr\t3\t1\n",
 		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t0\n1\t0\t0\t3\t3\t0\tb.exr\t4\t2\n",
+		/* a sign; no header at all, old-format lines */
+		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t0\n1\t0\t0\t3\t3\t0\tb.exr\t+4\t0\n",
+		"# x\n1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\t0\t3\t3\t2\tb.exr\n",
 	};
 #undef HDR
-	for (int b = 0; b < 6; b++) {
+	for (int b = 0; b < 8; b++) {
 		f = fopen(path, "w");
 		assert_non_null(f);
 		fputs(bad[b], f);
