@@ -1199,10 +1199,6 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 	}
 }
 
-#define STR_(x) #x
-#define STR(x) STR_(x)
-#define ACC_AA_DEPTH_STR STR(ACC_AA_DEPTH)
-
 /* The header line's start; the files before it ended with "scale output"
  * and had no depth and edges columns (read as 0 0). */
 #define REGIONS_HEADER "# povpress regions: pass x0 y0 x1 y1 scale output depth edges"
@@ -1244,6 +1240,16 @@ int plan_regions_save(const char *path, const struct plan *pl, int pass, char *c
 		return -1;
 	}
 	return file_commit(f, tmp, path, err, errlen);
+}
+
+int plan_merge_file(struct image *acc, const char *path, const struct plan_region *g, int pass,
+		    long *folded, char *err, size_t errlen)
+{
+	if (g->depth)
+		return accum_merge_aa_file(acc, path, g->scale, g->depth, g->edges, g->x0, g->y0,
+					   g->x1, g->y1, pass, folded, err, errlen);
+	return accum_merge_file(acc, path, g->scale, g->x0, g->y0, g->x1, g->y1, pass, folded,
+				err, errlen);
 }
 
 /* A region line's last two fields, depth and edges, into r, cut off s (the
@@ -1308,11 +1314,14 @@ int plan_regions_read(const char *path, struct plan_region **regions, char ***ou
 		if (sscanf(line, "%d\t%d\t%d\t%d\t%d\t%d%n", &pass, &r.x0, &r.y0, &r.x1, &r.y1,
 			   &r.scale, &off) != 6 || !off || line[off] != '\t' || !line[++off] ||
 		    (tail && regions_tail(line + off, &r))) {
-			errbuf_printf(err, errlen, "'%s' line %d: expected \"pass x0 y0 x1 y1 scale "
-				      "output%s\" separated by tabs%s", path, lineno,
-				      tail ? " depth edges" : "",
-				      tail ? " (depth 0 to " ACC_AA_DEPTH_STR ", edges 0 or 1; 0 0 "
-					     "unless the scale is 0)" : "");
+			if (tail)
+				errbuf_printf(err, errlen, "'%s' line %d: expected \"pass x0 y0 x1 y1 "
+					      "scale output depth edges\" separated by tabs (depth 0 "
+					      "to %d, edges 0 or 1; 0 0 unless the scale is 0)", path,
+					      lineno, ACC_AA_DEPTH);
+			else
+				errbuf_printf(err, errlen, "'%s' line %d: expected \"pass x0 y0 x1 y1 "
+					      "scale output\" separated by tabs", path, lineno);
 			goto fail;
 		}
 		if (cnt == alloc) {
@@ -1378,18 +1387,31 @@ static double top_sum(const double *v, size_t k, size_t n, double share)
 	return big;
 }
 
-unsigned plan_error_where(const double *e, size_t n)
+/* The errors e (n pixels) that are finite and positive, largest first,
+ * into a new array of *k (you free() it; NULL when memory runs out), and
+ * their sum into *all. */
+static double *sorted_errors(const double *e, size_t n, size_t *k, double *all)
 {
-	double *v = malloc(n * sizeof(*v)), all = 0.0;
+	double *v = malloc(n * sizeof(*v));
+	*k = 0;
+	*all = 0.0;
 	if (!v)
-		return 0;	/* the default samplers serve either way */
-	size_t k = 0;
+		return NULL;
 	for (size_t i = 0; i < n; i++)
 		if (isfinite(e[i]) && e[i] > 0.0) {
-			v[k++] = e[i];
-			all += e[i];
+			v[(*k)++] = e[i];
+			*all += e[i];
 		}
-	qsort(v, k, sizeof(*v), by_descending);
+	qsort(v, *k, sizeof(*v), by_descending);
+	return v;
+}
+
+unsigned plan_error_where(const double *e, size_t n)
+{
+	size_t k;
+	double all, *v = sorted_errors(e, n, &k, &all);
+	if (!v)
+		return 0;	/* the default samplers serve either way */
 	unsigned where = 0;
 	if (all > 0.0 && top_sum(v, k, n, PLAN_SPARSE_SHARE) >= 0.5 * all)
 		where |= PLAN_ERROR_FEW;
@@ -1399,16 +1421,14 @@ unsigned plan_error_where(const double *e, size_t n)
 	return where;
 }
 
-double plan_top_sum(const double *e, size_t n, double share)
+double plan_top_sum(const double *e, size_t n, double share, double *all)
 {
-	double *v = malloc(n * sizeof(*v));
+	size_t k;
+	double sum, *v = sorted_errors(e, n, &k, &sum);
+	if (all)
+		*all = sum;
 	if (!v)
 		return 0.0;
-	size_t k = 0;
-	for (size_t i = 0; i < n; i++)
-		if (isfinite(e[i]) && e[i] > 0.0)
-			v[k++] = e[i];
-	qsort(v, k, sizeof(*v), by_descending);
 	const double big = top_sum(v, k, n, share);
 	free(v);
 	return big;

@@ -227,6 +227,13 @@ int plan_regions_save(const char *path, const struct plan *pl, int pass, char *c
 int plan_regions_read(const char *path, struct plan_region **regions, char ***outputs,
 		      int **passes, size_t *n, char *err, size_t errlen);
 
+/* Fold region g's finished render, the image at path, into acc as pass
+ * `pass`: accum_merge_aa_file() at g's depth and edges where it has a
+ * depth (an antialiased render in scale 2's place), else
+ * accum_merge_file(); *folded the pixels that took samples. */
+int plan_merge_file(struct image *acc, const char *path, const struct plan_region *g, int pass,
+		    long *folded, char *err, size_t errlen);
+
 /*
  * Whether the estimated errors e (n pixels) sit in a few pixels: the
  * largest PLAN_SPARSE_SHARE of them (at least one) holding half of their
@@ -267,8 +274,9 @@ int plan_edge_error(const double *e, size_t n);
 
 /* The sum of the largest share of the errors e (n pixels; at least one;
  * values not finite or not positive left out): the top PLAN_EDGE_SHARE's
- * for render.c's edge pass.  0 when memory runs out. */
-double plan_top_sum(const double *e, size_t n, double share);
+ * for render.c's edge pass; into *all, unless all is NULL, the sum of all
+ * of them.  0 when memory runs out. */
+double plan_top_sum(const double *e, size_t n, double share, double *all);
 
 /* Both of the above from one sort of the errors: PLAN_ERROR_FEW if
  * plan_sparse_error(), PLAN_ERROR_EDGES if plan_edge_error(). */

@@ -412,11 +412,7 @@ int cmd_merge(int argc, char **argv)
 			missing++;
 			continue;
 		}
-		if (g->depth ? accum_merge_aa_file(&acc, outs[k], g->scale, g->depth, g->edges,
-						   g->x0, g->y0, g->x1, g->y1, passes[k], &folded,
-						   why, sizeof why)
-			     : accum_merge_file(&acc, outs[k], g->scale, g->x0, g->y0, g->x1, g->y1,
-						passes[k], &folded, why, sizeof why)) {
+		if (plan_merge_file(&acc, outs[k], g, passes[k], &folded, why, sizeof why)) {
 			errbuf_printf(err, sizeof err, "region %zu of '%s' (%s): %s", k + 1, regp,
 				      outs[k], why);
 			goto fail;

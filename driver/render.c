@@ -1903,13 +1903,11 @@ static double edge_target(const struct run *r, int *sparse)
 	    sparse_error(r, sparse) != SPARSE_EDGES)
 		return r->target;
 	const size_t n = (size_t)r->w * r->h;
-	double all = 0.0;
-	for (size_t i = 0; i < n; i++)
-		if (isfinite(r->est[i]) && r->est[i] > 0.0)
-			all += r->est[i];
+	double all;
+	const double top = plan_top_sum(r->est, n, PLAN_EDGE_SHARE, &all);
 	if (!(all / (double)n > r->target))
 		return r->target;	/* met: no pass */
-	const double t = (all - EDGE_TAKE * plan_top_sum(r->est, n, PLAN_EDGE_SHARE)) / (double)n;
+	const double t = (all - EDGE_TAKE * top) / (double)n;
 	if (!(t > 0.0 && t < r->target))
 		return r->target;
 	if (r->verbose)
@@ -2135,10 +2133,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			continue;
 		}
 		long folded = 0;
-		if (g->depth ? accum_merge_aa_file(&r->acc, outs[k], s, g->depth, g->edges, g->x0,
-						   g->y0, g->x1, g->y1, pass, &folded, err, errlen)
-			     : accum_merge_file(&r->acc, outs[k], s, g->x0, g->y0, g->x1, g->y1,
-						pass, &folded, err, errlen)) {
+		if (plan_merge_file(&r->acc, outs[k], g, pass, &folded, err, errlen)) {
 			fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n", pass,
 				g->x0, g->y0, g->x1, g->y1, err);
 			p.failed++;

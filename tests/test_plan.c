@@ -2230,15 +2230,18 @@ static void test_top_sum(void **state)
 	(void)state;
 	for (int i = 0; i < N; i++)
 		e[i] = (double)(i + 1);	/* the largest ten: 191 to 200 */
-	assert_close(plan_top_sum(e, N, 0.05), 1955.0, 1e-12, 0.0, "the top 5%");
-	assert_close(plan_top_sum(e, N, 0.001), 200.0, 1e-12, 0.0, "at least one pixel");
-	assert_close(plan_top_sum(e, N, 1.0), 20100.0, 1e-12, 0.0, "all of them");
+	assert_close(plan_top_sum(e, N, 0.05, NULL), 1955.0, 1e-12, 0.0, "the top 5%");
+	assert_close(plan_top_sum(e, N, 0.001, NULL), 200.0, 1e-12, 0.0, "at least one pixel");
+	assert_close(plan_top_sum(e, N, 1.0, NULL), 20100.0, 1e-12, 0.0, "all of them");
+	double all = 0.0;
+	plan_top_sum(e, N, 0.05, &all);
+	assert_close(all, 20100.0, 1e-12, 0.0, "the sum of all of them");
 	for (int i = 0; i < N; i++)
 		e[i] = i % 4 == 0 ? NAN : i % 4 == 1 ? -5.0 : i % 4 == 2 ? INFINITY : 0.0;
-	assert_close(plan_top_sum(e, N, 0.05), 0.0, 0.0, 0.0, "nothing left");
+	assert_close(plan_top_sum(e, N, 0.05, NULL), 0.0, 0.0, 0.0, "nothing left");
 	e[3] = 2.0;
 	e[7] = 3.0;
-	assert_close(plan_top_sum(e, N, 0.05), 5.0, 1e-12, 0.0, "the two that count");
+	assert_close(plan_top_sum(e, N, 0.05, NULL), 5.0, 1e-12, 0.0, "the two that count");
 }
 
 /* 7. The regions file round-trips; a bad line is reported with its number. */
