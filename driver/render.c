@@ -1871,7 +1871,10 @@ static void learn_costs(struct run *r, const struct plan_params *pp, const struc
 	free(ls);
 	free(nf);
 	r->cost_learnt += nl;
-	if (nl && r->verbose)
+	if (nl == 1 && r->verbose)
+		progress(r, "pass %d: 1 region render took %.2g times its planned CPU, its "
+			 "pixels' costs so scaled", r->pool_pass, lo);
+	else if (nl && r->verbose)
 		progress(r, "pass %d: %d region renders took %.2g to %.2g times their planned "
 			 "CPU, their pixels' costs so scaled", r->pool_pass, nl, lo, hi);
 }
@@ -2100,11 +2103,13 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		edges |= pl.regions[k].edges;
 	}
 	if (naa)
-		progress(r, "pass %d: the estimated error sits %s: %zu regions by POV-Ray's "
+		progress(r, "pass %d: the estimated error sits %s: %zu region%s by POV-Ray's "
 			 "antialiasing in place of scale 2, depth %d", pass,
-			 edges ? "at edges" : "in few pixels", naa, depth ? depth : 3);
-	progress(r, "pass %d: %zu regions, %ld pixels (%ld chosen), %.0f samples, about %.1f s",
-		 pass, n, pl.pixels, pl.chosen_pixels, pl.samples, guess + r->latency);
+			 edges ? "at edges" : "in few pixels", naa, naa == 1 ? "" : "s",
+			 depth ? depth : 3);
+	progress(r, "pass %d: %zu region%s, %ld pixels (%ld chosen), %.0f samples, about %.1f s",
+		 pass, n, n == 1 ? "" : "s", pl.pixels, pl.chosen_pixels, pl.samples,
+		 guess + r->latency);
 	int rc = pov_pool_run(jobs, n, &po, results, err, errlen);
 	r->renders_end = now_s();
 	struct pass_rec p = {0};
