@@ -91,7 +91,13 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * starfield 0.33 to 0.93, still_life (edges) the same.  The cells are
  * +R4's (ACC_AA_FEW); a render at +R3, which a budget may take
  * (aa_depth()), was cut into a quarter as many, accum_edge_cells(3), and
- * is merged by accum_merge_aa_file() with its depth.
+ * is merged by accum_merge_aa_file() with its depth.  At +R5 (ACC_AA_DEPTH)
+ * the weight stays ACC_AA_FEW: with 1024 cells the later grids moved the
+ * lamps' rims too little, and the estimate of hdr_highlights stood at 13
+ * to 24 times the truth at 3e-3 and 1e-3 and at 0.37 to 0.41 at 3e-4 and
+ * 4 s (by turns, one run each, 2026-12-04 16:30 UTC), where with 256 and
+ * the shared-corner rule for these renders (hidden_edge()) it is within
+ * 1.5 times at every setting but 3e-3 (see ACC_AA_DEPTH).
  */
 #define ACC_AA_FEW 256
 
@@ -110,7 +116,7 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * subdivided (its f x f render pixels differ by POV-Ray's threshold,
  * ACC_AA_THRESHOLD, or more).  At an edge the render's corners are half
  * a pixel apart and where they differ by the threshold POV-Ray
- * subdivides, to 1/16 of a pixel at +R4 (ACC_AA_DEPTH; +R3 where a
+ * subdivides, to 1/16 of a pixel at +R4 (ACC_AA_EDGE_DEPTH; +R3 where a
  * budget leaves too little time, render.c's aa_depth()) in the
  * twice-size frame: the pixel is accum_edge_cells(depth) cells' mean (at
  * +R4 2 x 2 render pixels of 8 x 8), and the base pass's one sample at its
@@ -139,10 +145,35 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  */
 #define ACC_AA_EDGE 7
 #define ACC_AA_DEEP 8
-/* POV-Ray's depth for an antialiased render in scale 2's place, for edges
- * or a few pixels alike (render.c's aa_depth(): +R3 under a budget that
- * would not fit it) */
-#define ACC_AA_DEPTH 4
+/*
+ * POV-Ray's depth for an antialiased render in scale 2's place taken for a
+ * few pixels (highlights, stars), ACC_AA_DEPTH, and for edges,
+ * ACC_AA_EDGE_DEPTH (render.c's choose_samplers(); aa_depth() goes down
+ * from there to +R3 under a budget that would not fit it).  +R5 cuts the
+ * cells' side to 1/64 of a pixel.  By turns against +R4 for both
+ * (scripts/abtest.sh, 160x120, one or two runs each; with the few-pixels
+ * weight kept at ACC_AA_FEW and the shared-corner rule of hidden_edge()
+ * for them as well):
+ *   - hdr_highlights: relMSE 9.1e-5 at 3e-3 to 3e-4 became 4.5e-5 to
+ *     3.6e-5, for 1.05 to 1.5 times the CPU, where POV-Ray's own best at
+ *     twice the size, +AM2 +A0.1 +R4, has 1.06e-4; under 2 and 4 s, 0.87
+ *     and 0.99 times the relMSE for the same CPU; its estimate within 1.5
+ *     times the truth at every setting but 3e-3;
+ *   - starfield: 0.91 to 1.15 times the relMSE for 0.92 to 1.04 times the
+ *     CPU;
+ *   - still_life's edges: 4.15e-6 became 2.87e-6 at every target, for 1.6
+ *     times the CPU (0.57 to 0.92 s);
+ *   - but Debian's lights/arealit3, lights/arealit1 and advanced/lamppost,
+ *     whose edges are penumbrae: the same relMSE at the targets for 1.3
+ *     to 2.4 times the CPU, and under 2 and 4 s 1.0 to 2.7 times the
+ *     relMSE (the pass ate the budget).
+ * So edges keep +R4.
+ */
+#define ACC_AA_DEPTH 5
+#define ACC_AA_EDGE_DEPTH 4
+/* The depth a regions file without the depth column (written before it
+ * had one) was rendered at: merged as then. */
+#define ACC_AA_DEPTH_V1 4
 
 /* The cells a pixel of such a render at POV-Ray's depth d stands for:
  * 2 x 2 render pixels of 2^(d-1) x 2^(d-1) (64 at +R3, 256 at +R4). */
@@ -150,7 +181,7 @@ static inline int accum_edge_cells(int d)
 {
 	return 1 << (2 * d);
 }
-_Static_assert(ACC_AA_FEW == 1 << (2 * ACC_AA_DEPTH), "ACC_AA_FEW is the cells at ACC_AA_DEPTH");
+_Static_assert(ACC_AA_FEW == 1 << (2 * 4), "ACC_AA_FEW is the cells at +R4");
 #define ACC_AA_THRESHOLD 0.1
 
 /*
@@ -284,7 +315,7 @@ int accum_split_diff(struct image *acc, const struct image *img, int s, char *er
  * accum_edge_cells(depth) cells: taken for edges (edges not 0), folded as
  * ACC_AA_EDGE says; else for a few pixels (ACC_AA_FEW).  Any other render
  * is folded as by the two, which take such a render as for a few pixels at
- * ACC_AA_DEPTH. */
+ * ACC_AA_DEPTH_V1 (+R4). */
 int accum_merge_aa_region(struct image *acc, const struct image *img, int oy, int s,
 			  int depth, int edges, int x0, int y0, int x1, int y1, int pass,
 			  long *folded, char *err, size_t errlen);

@@ -120,8 +120,9 @@ static const char usage_options2[] =
 	"                        base pass at edges, 5% of them holding two thirds\n"
 	"                        (not with radiosity or focal blur), scale 2 as\n"
 	"                        one render at twice the size with POV-Ray's\n"
-	"                        +AM2 +A0.1 +R4 +J (+R3 where a budget would not\n"
-	"                        fit it); where it is spread and the frame at\n"
+	"                        +AM2 +A0.1 +J, +R5 in few pixels, +R4 at edges\n"
+	"                        (less where a budget would not fit it); where it\n"
+	"                        is spread and the frame at\n"
 	"                        scale 4 takes less than 0.7 s on\n"
 	"                        the cores, as jitter; scale throughout where the\n"
 	"                        file sets assumed_gamma other than 1, in whose\n"
@@ -1338,8 +1339,8 @@ static void prelaunch_first(struct run *r)
 		kinds[nk++] = (struct pre_kind){ 2, 0, 0, 0 };
 	if (run_grid(r) != PLAN_GRID_NEVER && !r->focal)	/* one_step()'s jitter */
 		kinds[nk++] = (struct pre_kind){ 4, ACC_GRID_FRAME, 0, 0 };
-	if (run_grid(r) == PLAN_GRID_LARGE && !r->aa)
-		kinds[nk++] = (struct pre_kind){ ACC_AA, ACC_GRID_FRAME, ACC_AA_DEPTH, 0 };
+	if (run_grid(r) == PLAN_GRID_LARGE && !r->aa)	/* as at edges, the commoner */
+		kinds[nk++] = (struct pre_kind){ ACC_AA, ACC_GRID_FRAME, ACC_AA_EDGE_DEPTH, 0 };
 	prelaunch_start(r, 1, kinds, nk, r->cores);
 }
 
@@ -1599,10 +1600,10 @@ static int sparse_error(const struct run *r, int *memo)
  * The sampler of each region of a plan.  With --sampler auto, where the
  * error sits in a few pixels or at edges (sparse_error()), the regions of scale 2 are
  * rendered once at twice the image's size with POV-Ray's antialiasing,
- * +AM2 +A0.1 +R4 +J (frame ACC_GRID_FRAME; +R3 under a budget it would not
- * fit, aa_depth(); ACC_AA_FIRST for how they are folded, at edges
- * ACC_AA_EDGE): it
- * subdivides only where corners differ, down to 1/16 of a pixel at a
+ * +AM2 +A0.1 +J, +R5 in few pixels and +R4 at edges (frame ACC_GRID_FRAME;
+ * less under a budget it would not fit, aa_depth(); ACC_AA_FIRST for how
+ * they are folded, at edges ACC_AA_EDGE): it subdivides only where corners
+ * differ, down to 1/32 of a pixel at a
  * highlight, where scale 2 gives every pixel of the rectangles 4 samples;
  * at twice the size its corners are scale 2's density where it does not
  * (at the image's size, stars between corners went unseen: a pixel's base
@@ -1638,8 +1639,9 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
 	for (size_t k = m; k < pl->nregions; k++) {
 		pl->regions[k].scale = ACC_AA;
 		pl->regions[k].frame = first ? ACC_GRID_FRAME : 0;
-		pl->regions[k].depth = first ? ACC_AA_DEPTH : 0;
 		pl->regions[k].edges = first && *sparse == SPARSE_EDGES;
+		pl->regions[k].depth = !first ? 0 : pl->regions[k].edges ? ACC_AA_EDGE_DEPTH
+									: ACC_AA_DEPTH;
 	}
 	return first ? pl->nregions - m : 0;
 }
@@ -1690,9 +1692,10 @@ static double edge_render_cost(const struct run *r, const struct plan_params *pp
 }
 
 /*
- * The depth of a pass's antialiased renders in scale 2's place, taken for
- * edges or for a few pixels: ACC_AA_DEPTH (+R4), or under a budget
- * +R3 where EDGE_MARGIN times edge_render_cost() at +R4 would not fit it
+ * The depth of a pass's antialiased renders in scale 2's place: taken for
+ * a few pixels ACC_AA_DEPTH (+R5), for edges ACC_AA_EDGE_DEPTH (+R4)
+ * (choose_samplers()), or under a budget the deepest from there down to +R3
+ * where EDGE_MARGIN times edge_render_cost() fits it
  * (pp->budget's core-seconds, or for the dearest render the wall time
  * `left`).  At +R4 still_life's edges erred a quarter of +R3's (1.56e-5 to
  * 4.5e-6 at --target 3e-3, 1.3 to 1.6 CPU s), hdr_highlights' highlights
@@ -1710,19 +1713,22 @@ static double edge_render_cost(const struct run *r, const struct plan_params *pp
 static void aa_depth(const struct run *r, struct plan *pl, const struct plan_params *pp,
 		     double left)
 {
-	int d = ACC_AA_DEPTH;
-	if (r->budget > 0.0) {
-		double sum = 0.0, worst = 0.0;
-		for (size_t k = 0; k < pl->nregions; k++) {
-			if (!pl->regions[k].depth)
-				continue;
-			double c = edge_render_cost(r, pp, &pl->regions[k], d);
-			sum += c;
-			worst = c > worst ? c : worst;
+	int d = 0;
+	for (size_t k = 0; k < pl->nregions; k++)
+		d = pl->regions[k].depth > d ? pl->regions[k].depth : d;
+	if (r->budget > 0.0)
+		for (; d > 3; d--) {
+			double sum = 0.0, worst = 0.0;
+			for (size_t k = 0; k < pl->nregions; k++) {
+				if (!pl->regions[k].depth)
+					continue;
+				double c = edge_render_cost(r, pp, &pl->regions[k], d);
+				sum += c;
+				worst = c > worst ? c : worst;
+			}
+			if (EDGE_MARGIN * sum <= pp->budget && EDGE_MARGIN * worst <= left)
+				break;
 		}
-		if (!(EDGE_MARGIN * sum <= pp->budget && EDGE_MARGIN * worst <= left))
-			d = 3;
-	}
 	for (size_t k = 0; k < pl->nregions; k++)
 		if (pl->regions[k].depth)
 			pl->regions[k].depth = d;

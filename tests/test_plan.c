@@ -967,13 +967,14 @@ static double edge_strip(double v, double d, int s)
 
 
 /* 3c. An antialiased render in scale 2's place taken for edges at depth
- * d (4, ACC_AA_DEPTH, and 3): over a pixel's one sample it counts as
+ * d (5, ACC_AA_DEPTH, 4 and 3): over a pixel's one sample it counts as
  * the cells POV-Ray subdivided it into (4^d where its render pixels' colour
  * distance reaches the threshold, at least ACC_AA_FIRST), whose variance
  * is its 2 x 2 render pixels', its fold is
  * charged their spread over the cells their colour distance says POV-Ray
  * subdivided into, the pixels are marked (edge; subdivided where the
- * distance reaches the threshold); a depth outside 1 to 4 is refused; a
+ * distance reaches the threshold); taken for a few pixels, as many cells
+ * but at most ACC_AA_FEW (+R4's); a depth outside 1 to 5 is refused; a
  * later grid render takes none of its samples out as scale 2's repeats;
  * and between two such pixels no hidden edge is larger than the
  * threshold. */
@@ -994,12 +995,13 @@ static void test_merge_aa_edges(void **state)
 			for (int c = 0; c < 3; c++)
 				big.px[((size_t)Y * 10 + X) * 3 + c] =
 					(float)(0.4 + 0.1 * c + spread[X / 2] * pat[Y * 2 + X % 2]);
-	assert_int_equal(accum_edge_cells(ACC_AA_DEPTH), 256);
+	assert_int_equal(accum_edge_cells(ACC_AA_DEPTH), 1024);
+	assert_int_equal(accum_edge_cells(ACC_AA_DEPTH_V1), 256);
 	assert_int_equal(accum_edge_cells(3), 64);
 	make_acc(&plain, 5, 1, flat_value);
 	assert_int_equal(accum_merge_region(&plain, &big, 0, ACC_AA, 0, 0, 4, 0, 1, &folded, err,
 					    sizeof(err)), 0);
-	for (int depth = 3; depth <= 4; depth++) {
+	for (int depth = 3; depth <= ACC_AA_DEPTH; depth++) {
 		make_acc(&acc, 5, 1, flat_value);
 		assert_int_equal(accum_merge_aa_region(&acc, &big, 0, ACC_AA, depth, 1, 0, 0, 4, 0,
 							 1, &folded, err, sizeof(err)), 0);
@@ -1027,7 +1029,11 @@ static void test_merge_aa_edges(void **state)
 			if (range >= ACC_AA_THRESHOLD)
 				assert_int_equal(kf, ACC_AA_FEW);
 			const float *fd = accpx(&few, (size_t)x);
-			assert_true(fd[ACC_SAMPLES] == (float)(1 + k));
+			const double ec = edge_cells_want(range, cells < ACC_AA_FEW ? cells : ACC_AA_FEW);
+			const int kc = ec > ACC_AA_FIRST ? (int)lround(ec) : ACC_AA_FIRST;
+			assert_true(fd[ACC_SAMPLES] == (float)(1 + kc));
+			if (depth <= ACC_AA_DEPTH_V1)
+				assert_int_equal(kc, k);
 			assert_true(fd[ACC_SCALES] == q[ACC_SCALES]);
 			double d = 0.0, v = 0.0;
 			for (int c = 0; c < 3; c++) {
@@ -1064,16 +1070,17 @@ static void test_merge_aa_edges(void **state)
 					 range >= ACC_AA_THRESHOLD);
 			assert_true(accum_has_scale(&plain, (size_t)x, ACC_AA_NOGRID));
 		}
-		/* at ACC_AA_DEPTH the few pixels' fold is the plain one in
-		 * every channel (samples, variance, difference, scales) */
-		if (depth == ACC_AA_DEPTH)
+		/* from +R4 (ACC_AA_DEPTH_V1, the plain one's) on, the few
+		 * pixels' fold is the plain one in every channel (samples,
+		 * variance, difference, scales): their cells stop at ACC_AA_FEW */
+		if (depth >= ACC_AA_DEPTH_V1)
 			for (size_t i = 0; i < (size_t)5 * ACC_NCH; i++)
 				assert_true(memcmp(&few.px[i], &plain.px[i], sizeof(float)) == 0);
 		if (depth < ACC_AA_DEPTH)
 			image_release(&acc);	/* the deepest goes on below */
 		image_release(&few);
 	}
-	for (int depth = 0; depth <= 5; depth += 5) {
+	for (int depth = 0; depth <= ACC_AA_DEPTH + 1; depth += ACC_AA_DEPTH + 1) {
 		err[0] = '\0';
 		assert_int_equal(accum_merge_aa_region(&acc, &big, 0, ACC_AA, depth, 1, 0, 0, 4, 0,
 							 2, &folded, err, sizeof(err)), -1);
@@ -2315,7 +2322,7 @@ static void test_regions_file(void **state)
 		"# header\n1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\tx\t3\t3\t2\tb.exr\t0\t0\n",
 		"# header\n\n1\t0\t0\t3\t3\t2\t\t0\t0\n",
 		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t1\n1\t0\t0\t3\t3\t2\tb.exr\n",
-		HDR "1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\t0\t3\t3\t0\tb.exr\t5\t0\n",
+		HDR "1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\t0\t3\t3\t0\tb.exr\t6\t0\n",
 		HDR "\n1\t0\t0\t3\t3\t2\ta.exr\t3\t1\n",
 		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t0\n1\t0\t0\t3\t3\t0\tb.exr\t4\t2\n",
 		/* a sign; no header at all, old-format lines */
