@@ -982,6 +982,10 @@ static int step_beside(const float *const side[2], int c, double h2)
  * of it fell on this side (at --target 3e-3 still_life's 403 such pixels
  * held 1.1e-5 of its estimate of 2.55e-5, for a true 4e-7; with this
  * exemption the estimate is 1.66e-5 for a true 4.28e-6, the same image).
+ * The exemption holds for a render taken for a few pixels as well (both
+ * pixels ACC_AA_HALF; measured at +R5, see below), at whatever depth a
+ * budget gave it, and for a neighbour refined at scale 8 later, whose bit
+ * ACC_AA_DEEP shares, though there no cap bounded the term it loses.
  * The largest over the eight neighbours, mean over R, G, B.
  */
 static double hidden_edge(const struct image *acc, size_t i, int s)

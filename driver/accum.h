@@ -150,7 +150,7 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * few pixels (highlights, stars), ACC_AA_DEPTH, and for edges,
  * ACC_AA_EDGE_DEPTH (render.c's choose_samplers(); aa_depth() goes down
  * from there to +R3 under a budget that would not fit it).  +R5 cuts the
- * cells' side to 1/64 of a pixel.  By turns against +R4 for both
+ * cells' side to 1/32 of a pixel (1/16 at +R4).  By turns against +R4 for both
  * (scripts/abtest.sh, 160x120, one or two runs each; with the few-pixels
  * weight kept at ACC_AA_FEW and the shared-corner rule of hidden_edge()
  * for them as well):

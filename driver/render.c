@@ -1339,8 +1339,8 @@ static void prelaunch_first(struct run *r)
 		kinds[nk++] = (struct pre_kind){ 2, 0, 0, 0 };
 	if (run_grid(r) != PLAN_GRID_NEVER && !r->focal)	/* one_step()'s jitter */
 		kinds[nk++] = (struct pre_kind){ 4, ACC_GRID_FRAME, 0, 0 };
-	if (run_grid(r) == PLAN_GRID_LARGE && !r->aa)	/* as at edges, the commoner */
-		kinds[nk++] = (struct pre_kind){ ACC_AA, ACC_GRID_FRAME, ACC_AA_EDGE_DEPTH, 0 };
+	if (run_grid(r) == PLAN_GRID_LARGE && !r->aa)	/* a few pixels' (of_kind()) */
+		kinds[nk++] = (struct pre_kind){ ACC_AA, ACC_GRID_FRAME, ACC_AA_DEPTH, 0 };
 	prelaunch_start(r, 1, kinds, nk, r->cores);
 }
 

@@ -634,6 +634,21 @@ for n in r4 r3; do
 	check "... merge folds it to render's accumulation, bit for bit" \
 		idiff -fail 0 -failpercent 0 "$T/ae$n-acc1-ch.exr" "$T/ae$n.work-accum-ch.exr" >/dev/null
 done
+# ... and one taken for a few pixels, at +R5 (hdr_highlights' lamps): depth 5,
+# edges 0, and merge folds it as render does
+"$PP" render "$SC/hdr_highlights.pov" -o "$T/af5.exr" -W 160 -H 120 --jobs 1 --max-passes 1 \
+	-q --keep-workdir --workdir "$T/af5.work" -- +WT1 &&
+	"$PP" merge --init "$T/af5.work/base.exr" -o "$T/af5-acc0.exr" &&
+	"$PP" merge "$T/af5-acc0.exr" "$T/af5.work/regions.tsv" -o "$T/af5-acc1.exr" >/dev/null
+check "hdr_highlights, one pass: render, then merge its regions.tsv: runs" test $? -eq 0
+check "... its antialiased regions for a few pixels at +R5 (scale 0, depth 5, edges 0)" \
+	awk -F'\t' '!/^#/ && $6 == 0 { k++; if ($8 != 5 || $9 != 0) b = 1 } END { exit b || !k }' \
+	"$T/af5.work/regions.tsv"
+for f in af5-acc1 af5.work/accum; do
+	oiiotool "$T/$f.exr" --ch R,G,B,samples,scales,diff,var.R -o "$T/${f//\//-}-ch.exr" 2>/dev/null
+done
+check "... merge folds it to render's accumulation, bit for bit" \
+	idiff -fail 0 -failpercent 0 "$T/af5-acc1-ch.exr" "$T/af5.work-accum-ch.exr" >/dev/null
 differ() { ! idiff -fail 0 -failpercent 0 "$@" >/dev/null; }
 # the same regions in the format before depth and edges: folded as +R4 for a few
 # pixels, which differs (so the columns are what made the fold above right)
