@@ -119,7 +119,8 @@ struct plan_region {
 				 * 2's place (+A0.1 +R(depth) rather than +A0.0
 				 * +R4; render.c, choose_samplers()) */
 	int depth;		/* such a render's POV-Ray depth (+R, 1 to
-				 * ACC_AA_DEPTH; 0 for +R3), by which it is
+				 * ACC_AA_DEPTH; 0 for +R4, ACC_AA_DEPTH_V1, as a
+				 * regions file without the column), by which it is
 				 * folded (accum_merge_aa_file()) */
 	int edges;		/* such a render taken for edges (render.c's
 				 * edge rule), folded so

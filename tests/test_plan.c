@@ -2411,11 +2411,13 @@ static void test_plan_job(void **state)
 	assert_int_equal(region.y1, 7);
 	assert_string_equal(job.extra[1], "Antialias_Threshold=0.1");
 	assert_aa_options(&job, "+AM2", "+A0.0", "+R4", "+J");
-	/* in scale 2's place: twice the size, threshold 0.1, depth 3 */
+	/* in scale 2's place: twice the size, threshold 0.1; depth 0 (a
+	 * regions file without the column) at +R4, as merge folds it */
 	r.frame = ACC_GRID_FRAME;
 	plan_job(&base, &r, "out/a1.exr", &region, aextra, &job);
 	assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
-	assert_aa_options(&job, "+AM2", "+A0.1", "+R3", "+J");
+	assert_aa_options(&job, "+AM2", "+A0.1", "+R4", "+J");
+	assert_int_equal(ACC_AA_DEPTH_V1, 4);
 	/* at the depth it was given (render.c, aa_depth()) */
 	for (int d = 1; d <= ACC_AA_DEPTH; d++) {
 		char want[16];
