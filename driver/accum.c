@@ -259,7 +259,7 @@ static double edge_cells(double range, double cells)
 static long merge_aa(struct image *acc, const struct image *img, int oy, const int ch[3],
 		     int f, int x0, int y0, int x1, int y1, int pass, int depth, int edges)
 {
-	int cells = accum_edge_cells(depth ? depth : ACC_AA_DEPTH_V1);
+	int cells = accum_edge_cells(accum_aa_depth(depth));
 	if (!edges && cells > ACC_AA_FEW)
 		cells = ACC_AA_FEW;	/* see ACC_AA_FEW */
 	int n = aa_worth(acc, img, oy, ch, f, x0, y0, x1, y1);

@@ -175,6 +175,13 @@ extern const int accum_scales[ACC_NSCALES];	/* 1, 2, 4, 8, 16 */
  * had one) was rendered at: merged as then. */
 #define ACC_AA_DEPTH_V1 4
 
+/* The depth a region's render in scale 2's place is rendered and folded
+ * at: its own, or ACC_AA_DEPTH_V1 for depth 0. */
+static inline int accum_aa_depth(int depth)
+{
+	return depth ? depth : ACC_AA_DEPTH_V1;
+}
+
 /* The cells a pixel of such a render at POV-Ray's depth d stands for:
  * 2 x 2 render pixels of 2^(d-1) x 2^(d-1) (64 at +R3, 256 at +R4). */
 static inline int accum_edge_cells(int d)

@@ -1183,10 +1183,11 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 		/* POV-Ray's own adaptive antialiasing, jittered (accum.h) */
 		extra[job->nextra++] = "+AM2";
 		extra[job->nextra++] = r->frame > 0 ? "+A0.1" : "+A0.0";
-		static const char *const depth[] = { "+R4", "+R1", "+R2", "+R3", "+R4", "+R5" };
+		static const char *const depth[] = { "+R1", "+R2", "+R3", "+R4", "+R5" };
 		_Static_assert(ACC_AA_DEPTH == 5, "a +R for every depth");
+		const int d = accum_aa_depth(r->depth);
 		extra[job->nextra++] = r->frame <= 0 ? "+R4"
-				       : depth[r->depth >= 1 && r->depth <= ACC_AA_DEPTH ? r->depth : 0];
+				       : depth[(d >= 1 && d <= ACC_AA_DEPTH ? d : ACC_AA_DEPTH_V1) - 1];
 		extra[job->nextra++] = "+J";
 	} else if (grid) {
 		/* every pixel of the render supersampled (accum.h) */

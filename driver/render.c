@@ -1663,10 +1663,9 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
  * aa_depth() covers the dearest.
  */
 #define EDGE_SAMPLES 100.0
-static double edge_render_cost(const struct run *r, const struct plan_params *pp,
-			       const struct plan_region *g, int d)
+/* The pixels of region g of acc that count as edges for the cost above. */
+static long edge_pixels(const struct image *acc, const struct plan_region *g)
 {
-	const struct image *acc = &r->acc;
 	long e = 0;
 	for (int y = g->y0; y <= g->y1; y++)
 		for (int x = g->x0; x <= g->x1; x++) {
@@ -1683,9 +1682,17 @@ static double edge_render_cost(const struct run *r, const struct plan_params *pp
 			}
 			e += edge;
 		}
+	return e;
+}
+
+/* The cost above of region g, of an image w pixels wide, with e edge
+ * pixels (edge_pixels()), at depth d. */
+static double edge_render_cost(const struct plan_params *pp, const struct plan_region *g, int w,
+			       long e, int d)
+{
 	const double f2 = (double)ACC_GRID_FRAME * ACC_GRID_FRAME;
 	/* the region's cost a sample, the cost map's mean */
-	const double m = plan_region_map(pp, g, acc->w) / (double)plan_region_area(g);
+	const double m = plan_region_map(pp, g, w) / (double)plan_region_area(g);
 	return pp->cost_job + pp->cost_sample * m *
 				      (f2 * (double)plan_region_area(g) +
 				       ldexp(EDGE_SAMPLES, d - 4) * (double)e);
@@ -1716,19 +1723,23 @@ static void aa_depth(const struct run *r, struct plan *pl, const struct plan_par
 	int d = 0;
 	for (size_t k = 0; k < pl->nregions; k++)
 		d = pl->regions[k].depth > d ? pl->regions[k].depth : d;
-	if (r->budget > 0.0)
-		for (; d > 3; d--) {
-			double sum = 0.0, worst = 0.0;
-			for (size_t k = 0; k < pl->nregions; k++) {
-				if (!pl->regions[k].depth)
-					continue;
-				double c = edge_render_cost(r, pp, &pl->regions[k], d);
-				sum += c;
-				worst = c > worst ? c : worst;
+	if (r->budget > 0.0 && d > 3) {
+		/* the pass's cost and its dearest render at each depth from 3
+		 * to d, each region's edges counted once */
+		double sum[ACC_AA_DEPTH + 1] = { 0.0 }, worst[ACC_AA_DEPTH + 1] = { 0.0 };
+		for (size_t k = 0; k < pl->nregions; k++) {
+			if (!pl->regions[k].depth)
+				continue;
+			const long e = edge_pixels(&r->acc, &pl->regions[k]);
+			for (int t = 3; t <= d; t++) {
+				double c = edge_render_cost(pp, &pl->regions[k], r->acc.w, e, t);
+				sum[t] += c;
+				worst[t] = c > worst[t] ? c : worst[t];
 			}
-			if (EDGE_MARGIN * sum <= pp->budget && EDGE_MARGIN * worst <= left)
-				break;
 		}
+		while (d > 3 && !(EDGE_MARGIN * sum[d] <= pp->budget && EDGE_MARGIN * worst[d] <= left))
+			d--;
+	}
 	for (size_t k = 0; k < pl->nregions; k++)
 		if (pl->regions[k].depth)
 			pl->regions[k].depth = d;

@@ -615,40 +615,46 @@ check "... merge folds it to render's accumulation, bit for bit" \
 # still_life at 160x120 takes its first pass for edges; costing a sample at
 # 4e-5 s under a 4 s budget, +R3 (+R4 at 1e-5 s, +R3 from 2e-5 s by hand,
 # 2026-12-04)
-for n in r4 r3; do
-	o=()
-	[[ $n == r3 ]] && o=(--budget 4 --cost-job 0.05 --cost-sample 4e-5)
-	"$PP" render "$SC/still_life.pov" -o "$T/ae$n.exr" -W 160 -H 120 --jobs 1 --max-passes 1 \
-		-q "${o[@]}" --keep-workdir --workdir "$T/ae$n.work" -- +WT1 &&
-		"$PP" merge --init "$T/ae$n.work/base.exr" -o "$T/ae$n-acc0.exr" &&
-		"$PP" merge "$T/ae$n-acc0.exr" "$T/ae$n.work/regions.tsv" -o "$T/ae$n-acc1.exr" \
+# one_pass TAG SCENE [OPTION ...]: render SCENE's base pass and one pass at
+# 160x120 into $T/TAG.work, then merge its regions.tsv onto the base pass
+# into $T/TAG-acc1.exr
+one_pass() {
+	local tag=$1 scene=$2
+	shift 2
+	"$PP" render "$scene" -o "$T/$tag.exr" -W 160 -H 120 --jobs 1 --max-passes 1 \
+		-q "$@" --keep-workdir --workdir "$T/$tag.work" -- +WT1 &&
+		"$PP" merge --init "$T/$tag.work/base.exr" -o "$T/$tag-acc0.exr" &&
+		"$PP" merge "$T/$tag-acc0.exr" "$T/$tag.work/regions.tsv" -o "$T/$tag-acc1.exr" \
 			>/dev/null
-	check "still_life, one pass ($n): render, then merge its regions.tsv: runs" test $? -eq 0
-	check "... every region antialiased for edges at ${n/r/+R} (scale 0, depth ${n#r}, edges 1)" \
-		awk -F'\t' -v d="${n#r}" '!/^#/ { k++; if ($6 != 0 || $8 != d || $9 != 1) b = 1 }
-			END { exit b || !k }' "$T/ae$n.work/regions.tsv"
-	for f in "ae$n-acc1" "ae$n.work/accum"; do
+}
+# folds_alike TAG: check that one_pass TAG's merge equals render's accumulation
+folds_alike() {
+	local f
+	for f in "$1-acc1" "$1.work/accum"; do
 		oiiotool "$T/$f.exr" --ch R,G,B,samples,scales,diff,var.R -o "$T/${f//\//-}-ch.exr" \
 			2>/dev/null
 	done
 	check "... merge folds it to render's accumulation, bit for bit" \
-		idiff -fail 0 -failpercent 0 "$T/ae$n-acc1-ch.exr" "$T/ae$n.work-accum-ch.exr" >/dev/null
+		idiff -fail 0 -failpercent 0 "$T/$1-acc1-ch.exr" "$T/$1.work-accum-ch.exr" >/dev/null
+}
+for n in r4 r3; do
+	o=()
+	[[ $n == r3 ]] && o=(--budget 4 --cost-job 0.05 --cost-sample 4e-5)
+	one_pass "ae$n" "$SC/still_life.pov" "${o[@]}"
+	check "still_life, one pass ($n): render, then merge its regions.tsv: runs" test $? -eq 0
+	check "... every region antialiased for edges at ${n/r/+R} (scale 0, depth ${n#r}, edges 1)" \
+		awk -F'\t' -v d="${n#r}" '!/^#/ { k++; if ($6 != 0 || $8 != d || $9 != 1) b = 1 }
+			END { exit b || !k }' "$T/ae$n.work/regions.tsv"
+	folds_alike "ae$n"
 done
 # ... and one taken for a few pixels, at +R5 (hdr_highlights' lamps): depth 5,
 # edges 0, and merge folds it as render does
-"$PP" render "$SC/hdr_highlights.pov" -o "$T/af5.exr" -W 160 -H 120 --jobs 1 --max-passes 1 \
-	-q --keep-workdir --workdir "$T/af5.work" -- +WT1 &&
-	"$PP" merge --init "$T/af5.work/base.exr" -o "$T/af5-acc0.exr" &&
-	"$PP" merge "$T/af5-acc0.exr" "$T/af5.work/regions.tsv" -o "$T/af5-acc1.exr" >/dev/null
+one_pass af5 "$SC/hdr_highlights.pov"
 check "hdr_highlights, one pass: render, then merge its regions.tsv: runs" test $? -eq 0
 check "... its antialiased regions for a few pixels at +R5 (scale 0, depth 5, edges 0)" \
 	awk -F'\t' '!/^#/ && $6 == 0 { k++; if ($8 != 5 || $9 != 0) b = 1 } END { exit b || !k }' \
 	"$T/af5.work/regions.tsv"
-for f in af5-acc1 af5.work/accum; do
-	oiiotool "$T/$f.exr" --ch R,G,B,samples,scales,diff,var.R -o "$T/${f//\//-}-ch.exr" 2>/dev/null
-done
-check "... merge folds it to render's accumulation, bit for bit" \
-	idiff -fail 0 -failpercent 0 "$T/af5-acc1-ch.exr" "$T/af5.work-accum-ch.exr" >/dev/null
+folds_alike af5
 differ() { ! idiff -fail 0 -failpercent 0 "$@" >/dev/null; }
 # the same regions in the format before depth and edges: folded as +R4 for a few
 # pixels, which differs (so the columns are what made the fold above right)
