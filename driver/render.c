@@ -2037,9 +2037,9 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	if (pre_idx) {
 		pre = r->pre;
 		r->pre = NULL;
-		naa = 0;
+		naa = 0;	/* in scale 2's place, as choose_samplers() counts */
 		for (size_t k = 0; k < pl.nregions; k++)
-			naa += pl.regions[k].scale == ACC_AA;
+			naa += pl.regions[k].scale == ACC_AA && pl.regions[k].frame > 0;
 		progress(r, "pass %d: %zu region renders started %s", pass, pl.nregions,
 			 pass == 1 ? "with the base pass" : "during the pass before");
 	} else {
@@ -2122,8 +2122,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	if (naa)
 		progress(r, "pass %d: the estimated error sits %s: %zu region%s by POV-Ray's "
 			 "antialiasing in place of scale 2, depth %d", pass,
-			 edges ? "at edges" : "in few pixels", naa, naa == 1 ? "" : "s",
-			 depth ? depth : 3);
+			 edges ? "at edges" : "in few pixels", naa, naa == 1 ? "" : "s", depth);
 	progress(r, "pass %d: %zu region%s, %ld pixels (%ld chosen), %.0f samples, about %.1f s",
 		 pass, n, n == 1 ? "" : "s", pl.pixels, pl.chosen_pixels, pl.samples,
 		 guess + r->latency);
