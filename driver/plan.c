@@ -194,6 +194,13 @@ double plan_job_cost(const struct plan_params *p, int s, double px)
 	return job_cost(p, s, px);
 }
 
+double plan_radiosity_trace(double cost_pixel, double px, double rays, int k)
+{
+	const double r = rays > 0.0 ? PLAN_RAD_RAY_COST * rays : 0.0;
+	const double a = cost_pixel / (1.0 + r);	/* a pixel's ray */
+	return a * px * ((double)k * k + r * pow(k, PLAN_RAD_RAY_GROWTH));
+}
+
 double plan_region_map(const struct plan_params *p, const struct plan_region *r, int w)
 {
 	if (!p->cost_map)

@@ -78,6 +78,33 @@ struct plan_params {
  * invocation and, with cost_frame, its frame. */
 double plan_job_cost(const struct plan_params *p, int s, double px);
 
+/*
+ * The trace CPU of a whole frame at k times the size of an image of px
+ * pixels, with radiosity, on one thread, from a render at the image's size
+ * whose trace cost cost_pixel a pixel and shot rays radiosity rays a pixel
+ * during the render proper (POV-Ray's "Radiosity (final) rays shot", over
+ * px).  Those rays grow far more slowly than the frame's pixels (the
+ * samples are reused across more of them), so the cost a pixel at the
+ * image's size is too high for a larger frame when they are a large part
+ * of it: Debian's radiosity/radiosity2.pov at 160x120 costs 4.1e-6 CPU s a
+ * pixel on two threads (109,130 such rays, 5.7 a pixel), at 1280x960
+ * 1.3e-6 on one (409,045 rays); so priced, scale 8 was predicted at 6.5 s
+ * where it takes 1.6 s.  The trace is split as a (px + PLAN_RAD_RAY_COST
+ * R) for R = rays px, and the frame at scale k costs a (k^2 px +
+ * PLAN_RAD_RAY_COST R k^PLAN_RAD_RAY_GROWTH).  Fitted on Debian's
+ * radiosity2, radiosity3 and radiosity_37 at scales 1 and 8 on one thread
+ * (a ray 0.44, 0.60 and 0.82 of a pixel; the rays growing as k^0.63,
+ * k^0.66 and k^0.80), it predicts, from a render on two threads, their
+ * scale 8 at 0.94, 0.93 and 1.06 times its trace CPU, and rad_def_test_37's
+ * and scenes/radiosity_room.pov's (few such rays) at 1.31 and 1.14, Debian's
+ * gamma/gamma_showcase.pov's scale 4 at 1.15 (`povray -D +WT2` at scale 1
+ * and `+WT1` at the others, 2026-12-04).  Without such rays:
+ * cost_pixel k^2 px.
+ */
+#define PLAN_RAD_RAY_COST 0.5
+#define PLAN_RAD_RAY_GROWTH (2.0 / 3.0)
+double plan_radiosity_trace(double cost_pixel, double px, double rays, int k);
+
 /* Grid renders: never (resolution scaling), for every scale of 4 or more,
  * or for those whose scaled frame would exceed grid_frame pixels
  * (PLAN_GRID_FRAME, or PLAN_FOCAL_FRAME where render's --sampler auto finds

@@ -967,6 +967,10 @@ int pov_stats_parse(const char *text, struct pov_stats *st)
 			if (st->rays_saved < 0)
 				st->rays_saved = 0;
 			st->have |= POV_HAVE_RAYS;
+		} else if (!strncmp(line, "Radiosity (final) rays shot:", 28)) {
+			st->rad_final_rays = field_ll(line, "shot:");
+			if (st->rad_final_rays >= 0)
+				st->have |= POV_HAVE_RAD_RAYS;
 		}
 		memcpy(line, next, sizeof(line));
 	}

@@ -123,6 +123,7 @@ enum {
 	POV_HAVE_TRACE = 1 << 4,	/* "Trace Time:" */
 	POV_HAVE_PIXELS = 1 << 5,	/* the "Pixels: Samples: Smpls/Pxl:" line */
 	POV_HAVE_RAYS = 1 << 6,		/* the "Rays: Saved:" line */
+	POV_HAVE_RAD_RAYS = 1 << 7,	/* "Radiosity (final) rays shot:" */
 };
 
 struct pov_stats {
@@ -135,6 +136,8 @@ struct pov_stats {
 	double samples_per_pixel;	/* samples / pixels; 0 when POV-Ray prints "-" */
 	long long rays;			/* camera rays: pixels + samples */
 	long long rays_saved;		/* "Saved:" */
+	long long rad_final_rays;	/* radiosity sample rays shot during the
+					 * render proper, after the pretrace */
 };
 
 /*

@@ -269,6 +269,8 @@ struct run {
 	double cost_sample_measured;	/* cost_sample before rounding (radiosity_time()) */
 	double tail;		/* the base pass's wait on POV-Ray's exit */
 	double pretrace_s;	/* the base pass's radiosity pretrace, CPU s */
+	double rad_rays;	/* the base pass's radiosity rays after the
+				 * pretrace, per pixel (plan_radiosity_trace()) */
 	int radiosity;
 	int rad_scale;		/* the scale the radiosity solution was computed at */
 	int jittered;		/* --sampler auto chose PLAN_GRID_ONLY for the run
@@ -979,13 +981,21 @@ static int radiosity_big(const struct run *r)
  * gamma/gamma_showcase.pov at 320x240: 3.0 s wall on one thread, 1.73 to
  * 1.83 s on two) */
 #define RAD_CORE_SHARE 0.85
+/* The pass's CPU before its exit: its pretrace, then its trace
+ * (plan_radiosity_trace()) */
+static double radiosity_work(const struct run *r, int k)
+{
+	return r->pretrace_s + plan_radiosity_trace(r->cost_sample_measured, (double)r->w * r->h,
+						    r->rad_rays, k);
+}
+
 static double radiosity_time(const struct run *r, int k, int threads)
 {
 	/* a whole-frame render waits for POV-Ray's exit: the latency and the
 	 * tail the region renders do not wait on; one started early (on one
 	 * thread) waits only from its gate */
 	const double lat = threads == 1 && rad_prelaunched(r, k) ? r->pre_latency : r->latency;
-	const double work = r->pretrace_s + r->cost_sample_measured * k * k * (double)r->w * r->h;
+	const double work = radiosity_work(r, k);
 	return lat + r->tail + (threads > 1 ? work / (RAD_CORE_SHARE * threads) : work);
 }
 
@@ -1027,9 +1037,9 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 			k = big, took_big = 1;
 		else if (r->verbose)
 			fprintf(stderr, "povpress render: radiosity pass not at scale %d: it would "
-				"take about %.1f s (pretrace %.2f s, %.3g s a sample), and %.1f s "
-				"are left\n", big, tbig, r->pretrace_s, r->cost_sample_measured,
-				r->budget - elapsed(r) - after);
+				"take about %.1f s (pretrace %.2f s, %.3g s a sample, %.2g radiosity "
+				"rays a pixel), and %.1f s are left\n", big, tbig, r->pretrace_s,
+				r->cost_sample_measured, r->rad_rays, r->budget - elapsed(r) - after);
 	}
 	/* at scale 1 the pass repeats, on one thread, a base pass that ran on
 	 * several; on one core it would repeat it exactly */
@@ -1486,6 +1496,8 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	r->cost_sample = trace / rays;
 	/* the pretrace, which the radiosity pass repeats on one thread */
 	r->pretrace_s = (st->have & POV_HAVE_RADIOSITY) ? st->radiosity.cpu_s : 0.0;
+	r->rad_rays = (st->have & POV_HAVE_RADIOSITY) && (st->have & POV_HAVE_RAD_RAYS) ?
+			      (double)st->rad_final_rays / ((double)r->w * r->h) : 0.0;
 	if (!(r->cost_sample > 1e-9))
 		r->cost_sample = 1e-9;
 	double setup = res.cpu_s - trace;

@@ -710,6 +710,7 @@ static void test_stats_no_aa(void **state)
 	parse_fixture("noaa.txt", &st, 0);
 	assert_int_equal(st.have, POV_HAVE_PARSE | POV_HAVE_BOUNDING | POV_HAVE_TRACE |
 				  POV_HAVE_PIXELS | POV_HAVE_RAYS);
+	assert_int_equal(st.rad_final_rays, 0);
 	assert_int_equal(st.pixels, 3072);
 	assert_int_equal(st.samples, 0);
 	assert_float_equal(st.samples_per_pixel, 0.0, 0);
@@ -765,6 +766,16 @@ static void test_stats_radiosity_photons(void **state)
 	assert_float_equal(st.trace.wall_s, 0.023, 1e-12);
 	assert_int_equal(st.pixels, 5577);
 	assert_int_equal(st.rays, 20347);
+	/* the render proper shot none of its radiosity rays: "Radiosity
+	 * Depth 0 rays shot: 14770" and "Radiosity sample rays shot" are the
+	 * pretrace's and the total */
+	assert_true(st.have & POV_HAVE_RAD_RAYS);
+	assert_int_equal(st.rad_final_rays, 0);
+	assert_int_equal(pov_stats_parse("Radiosity (final) rays shot:           409045\n"
+					 "Pixels:  10   Samples:  0   Smpls/Pxl: 0.00\n"
+					 "  Trace Time:  0 hours  0 minutes  0 seconds (0.5 seconds)\n"
+					 "    using 1 thread(s) with 0.5 CPU-seconds total\n", &st), 0);
+	assert_int_equal(st.rad_final_rays, 409045);
 
 	parse_fixture("photons.txt", &st, 0);
 	assert_true(st.have & POV_HAVE_PHOTON);
