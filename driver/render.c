@@ -1523,8 +1523,10 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	r->cost_job = setup > 0.01 ? quantise(setup, 1.0) : 0.01;
 	if (r->user_cost_job > 0.0)
 		r->cost_job = r->user_cost_job;
-	if (r->user_cost_sample > 0.0)
+	if (r->user_cost_sample > 0.0) {	/* the cost of a sample at every scale */
 		r->cost_sample = r->cost_sample_measured = r->user_cost_sample;
+		r->rad_rays = 0.0;
+	}
 	struct pass_rec p = {0};
 	p.pass = 0;
 	p.wall_s = now_s() - t;
