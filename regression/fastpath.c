@@ -124,7 +124,12 @@ long lpr_fast_strip(const struct lpr_filters *f, const float *clean, int w, int 
 	const size_t xa = (size_t)r * nch, xb = (size_t)(w - r) * nch;
 
 	/* Horizontal passes, BLK outputs at a time so that the sums stay in
-	 * registers; the tail of a row is done one element at a time. */
+	 * registers; the tail of a row is done one element at a time.  The
+	 * taps are symmetric (t, t u^2) or antisymmetric (t u) about the
+	 * centre, whose t u and t u^2 are 0: each pair of values at +-i is
+	 * summed or differenced once, then weighted (in the vertical passes
+	 * too). */
+	const double tc = f->t[r];
 	for (int y = ha; y < hb; y++) {
 		const float *in = clean + (size_t)y * rowlen;
 		double *o0 = hw + (size_t)(y - ha) * rowlen;
@@ -132,15 +137,17 @@ long lpr_fast_strip(const struct lpr_filters *f, const float *clean, int w, int 
 		double *o2 = hu2 + (size_t)(y - ha) * rowlen;
 		size_t k = xa;
 		for (; k + BLK <= xb; k += BLK) {
-			double s0[BLK] = {0}, s1[BLK] = {0}, s2[BLK] = {0};
-			for (int i = -r; i <= r; i++) {
-				const float *src = in + (ptrdiff_t)i * nch + k;
-				double t = f->t[i + r], tu = f->tu[i + r], tu2 = f->tu2[i + r];
+			double s0[BLK], s1[BLK] = {0}, s2[BLK] = {0};
+			for (int m = 0; m < BLK; m++)
+				s0[m] = tc * in[k + m];
+			for (int i = 1; i <= r; i++) {
+				const float *p = in + k + (ptrdiff_t)i * nch, *q = in + k - (ptrdiff_t)i * nch;
+				const double t = f->t[i + r], tu = f->tu[i + r], tu2 = f->tu2[i + r];
 				for (int m = 0; m < BLK; m++) {
-					double yv = src[m];
-					s0[m] += t * yv;
-					s1[m] += tu * yv;
-					s2[m] += tu2 * yv;
+					const double a = (double)p[m] + q[m], d = (double)p[m] - q[m];
+					s0[m] += t * a;
+					s1[m] += tu * d;
+					s2[m] += tu2 * a;
 				}
 			}
 			memcpy(o0 + k, s0, sizeof s0);
@@ -148,12 +155,12 @@ long lpr_fast_strip(const struct lpr_filters *f, const float *clean, int w, int 
 			memcpy(o2 + k, s2, sizeof s2);
 		}
 		for (; k < xb; k++) {
-			double s0 = 0.0, s1 = 0.0, s2 = 0.0;
-			for (int i = -r; i <= r; i++) {
-				double yv = in[(ptrdiff_t)k + (ptrdiff_t)i * nch];
-				s0 += f->t[i + r] * yv;
-				s1 += f->tu[i + r] * yv;
-				s2 += f->tu2[i + r] * yv;
+			double s0 = tc * in[k], s1 = 0.0, s2 = 0.0;
+			for (int i = 1; i <= r; i++) {
+				const double p = in[k + (size_t)i * nch], q = in[k - (size_t)i * nch];
+				s0 += f->t[i + r] * (p + q);
+				s1 += f->tu[i + r] * (p - q);
+				s2 += f->tu2[i + r] * (p + q);
 			}
 			o0[k] = s0;
 			o1[k] = s1;
@@ -182,16 +189,26 @@ long lpr_fast_strip(const struct lpr_filters *f, const float *clean, int w, int 
 				int nb = kb - k0 < VBLK ? (int)(kb - k0) : VBLK;
 				double s00[VBLK] = {0}, s20[VBLK] = {0}, s02[VBLK] = {0};
 				double sx[VBLK] = {0}, sy[VBLK] = {0};
-				for (int j = -r; j <= r; j++) {
-					const size_t off = (size_t)(y + j - ha) * rowlen + k0;
-					const double *rw = hw + off, *ru = hu + off, *ru2 = hu2 + off;
-					double t = f->t[j + r], tv = f->tu[j + r], tv2 = f->tu2[j + r];
-					for (int m = 0; m < (nb == VBLK ? VBLK : nb); m++) {
-						s00[m] += t * rw[m];
-						s20[m] += t * ru2[m];
-						s02[m] += tv2 * rw[m];
-						sx[m] += t * ru[m];
-						sy[m] += tv * rw[m];
+				const int nm = nb == VBLK ? VBLK : nb;
+				/* the centre row, then the rows at +-j in pairs (as the
+				 * horizontal pass) */
+				const size_t oc = (size_t)(y - ha) * rowlen + k0;
+				for (int m = 0; m < nm; m++) {
+					s00[m] = tc * hw[oc + m];
+					s20[m] = tc * hu2[oc + m];
+					sx[m] = tc * hu[oc + m];
+				}
+				for (int j = 1; j <= r; j++) {
+					const size_t op = oc + (size_t)j * rowlen, on = oc - (size_t)j * rowlen;
+					const double t = f->t[j + r], tv = f->tu[j + r], tv2 = f->tu2[j + r];
+					for (int m = 0; m < nm; m++) {
+						const double aw = hw[op + m] + hw[on + m];
+						const double dw = hw[op + m] - hw[on + m];
+						s00[m] += t * aw;
+						s20[m] += t * (hu2[op + m] + hu2[on + m]);
+						s02[m] += tv2 * aw;
+						sx[m] += t * (hu[op + m] + hu[on + m]);
+						sy[m] += tv * dw;
 					}
 				}
 				size_t nbytes = (size_t)nb * sizeof(double);
