@@ -954,6 +954,12 @@ static int radiosity_scale(const struct run *r)
  * cost a sample, higher, predicted 4.2 to 4.4 s, and scale 4 ran (7.8e-4).
  * With the margin it would not fit --budget 4 at all. */
 #define RAD_BIG_MARGIN 1.0
+/* ... but where the base pass shot radiosity rays after its pretrace, the
+ * price of the larger frame rests on plan_radiosity_trace()'s model, which
+ * put its fits' scale 8 at 0.93 to 1.06 times the trace: Debian's
+ * radiosity/radiosity2.pov at 160x120 under --budget 2 took the 1280x960
+ * pass without a margin in one run of three and ended at 2.14 s. */
+#define RAD_RAYS_MARGIN 1.15
 static int radiosity_big(const struct run *r)
 {
 	if (r->budget <= 0.0 || r->user_rad_scale >= 0)
@@ -1033,7 +1039,8 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	int took_big = 0;
 	if (big > k) {
 		const double tbig = radiosity_time(r, big, 1);
-		if (elapsed(r) + RAD_BIG_MARGIN * tbig + after <= r->budget)
+		const double m = r->rad_rays > 0.0 ? RAD_RAYS_MARGIN : RAD_BIG_MARGIN;
+		if (elapsed(r) + m * tbig + after <= r->budget)
 			k = big, took_big = 1;
 		else if (r->verbose)
 			fprintf(stderr, "povpress render: radiosity pass not at scale %d: it would "
