@@ -987,21 +987,15 @@ static int radiosity_big(const struct run *r)
  * gamma/gamma_showcase.pov at 320x240: 3.0 s wall on one thread, 1.73 to
  * 1.83 s on two) */
 #define RAD_CORE_SHARE 0.85
-/* The pass's CPU before its exit: its pretrace, then its trace
- * (plan_radiosity_trace()) */
-static double radiosity_work(const struct run *r, int k)
-{
-	return r->pretrace_s + plan_radiosity_trace(r->cost_sample_measured, (double)r->w * r->h,
-						    r->rad_rays, k);
-}
-
 static double radiosity_time(const struct run *r, int k, int threads)
 {
 	/* a whole-frame render waits for POV-Ray's exit: the latency and the
 	 * tail the region renders do not wait on; one started early (on one
 	 * thread) waits only from its gate */
 	const double lat = threads == 1 && rad_prelaunched(r, k) ? r->pre_latency : r->latency;
-	const double work = radiosity_work(r, k);
+	/* its CPU before its exit: the pretrace, then the trace */
+	const double work = r->pretrace_s + plan_radiosity_trace(r->cost_sample_measured,
+								 (double)r->w * r->h, r->rad_rays, k);
 	return lat + r->tail + (threads > 1 ? work / (RAD_CORE_SHARE * threads) : work);
 }
 

@@ -2251,7 +2251,6 @@ static void test_top_sum(void **state)
 	assert_close(plan_top_sum(e, N, 0.05, NULL), 5.0, 1e-12, 0.0, "the two that count");
 }
 
-/* 7. The regions file round-trips; a bad line is reported with its number. */
 /* The radiosity pass's trace model against measured traces: Debian's
  * radiosity/radiosity2.pov at 160x120 on two threads took 0.078 CPU s for
  * its trace and shot 109,130 radiosity rays after the pretrace; at 1280x960
@@ -2280,6 +2279,7 @@ static void test_radiosity_trace(void **state)
 			    plan_radiosity_trace(0.078 / px, px, 109130 / px, k));
 }
 
+/* 7. The regions file round-trips; a bad line is reported with its number. */
 static void test_regions_file(void **state)
 {
 	struct plan_region rs[3] = {
