@@ -302,7 +302,9 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			 * (ACC_AA_FEW at +R4); only for edges is the spread over
 			 * them */
 			const double ec = first ? edge_cells(range, cells) : 1.0;
-			const double ek = edge ? ec : 1.0;
+			const double ek = !edge ? 1.0
+				: edges != ACC_AA_FOR_SPREAD ? ec
+				: range > ACC_AA_SPREAD_RANGE ? range / ACC_AA_SPREAD_RANGE : 1.0;
 			int k = first ? (ec > ACC_AA_FIRST ? (int)lround(ec) : ACC_AA_FIRST)
 				      : own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
 			/* taken for edges, the cells vary as the render pixels
@@ -335,6 +337,8 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 					add |= 1u << ACC_AA_NOGRID;
 				if (edge)
 					add |= 1u << ACC_AA_EDGE;
+				if (edges == ACC_AA_FOR_SPREAD)
+					add |= 1u << ACC_AA_SPREAD_BIT;
 				if ((edge || first) && range >= ACC_AA_THRESHOLD)
 					add |= 1u << ACC_AA_DEEP;
 				acc->px[i * ACC_NCH + ACC_SCALES] = (float)(m | add);
@@ -1042,9 +1046,12 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 			/* between two pixels of a render taken for edges, at most
 			 * the threshold, and at most what this pixel's samples
 			 * spread over (ACC_AA_STEP_SD of their deviation: after
-			 * the render's fold, about its render pixels') */
+			 * the render's fold, about its render pixels'), but not
+			 * for +AM1's (ACC_AA_SPREAD_BIT), which shares no corners
+			 * with its neighbours */
 			double cap = ACC_AA_THRESHOLD / 3.0;
-			if (seen && own && ACC_AA_STEP_SD * sqrt(o[ACC_VAR_R + c]) < cap)
+			if (seen && own && !accum_has_scale(acc, i, ACC_AA_SPREAD_BIT) &&
+			    ACC_AA_STEP_SD * sqrt(o[ACC_VAR_R + c]) < cap)
 				cap = ACC_AA_STEP_SD * sqrt(o[ACC_VAR_R + c]);
 			if (seen && fabs(dh) > cap)
 				dh = d > 0.0 ? cap : -cap;

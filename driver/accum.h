@@ -192,6 +192,55 @@ _Static_assert(ACC_AA_FEW == 1 << (2 * 4), "ACC_AA_FEW is the cells at +R4");
 #define ACC_AA_THRESHOLD 0.1
 
 /*
+ * What a render in scale 2's place was taken for (struct plan_region's
+ * edges, the regions file's last column): a few pixels, edges (both
+ * POV-Ray's +AM2), or error spread over the frame of a scene whose samples
+ * are cheap (render.c's spread_am1()): there the render is POV-Ray's
+ * non-recursive +AM1 +A0.03 +R(2^(depth-1)) +J at twice the size, which
+ * gives a render pixel whose colour differs from a neighbour's by the
+ * threshold a jittered grid of 2^(depth-1) x 2^(depth-1) samples, so a
+ * pixel it subdivided has accum_edge_cells(depth) samples, as +AM2 at that
+ * depth has cells.  At 640x480 (one run each, 2026-12-04 21:30 UTC,
+ * `--target 1e-3`, CPU of all processes): soft_shadows relMSE 4.1e-5 in
+ * 6.5 s where scale 2 had 3.2e-4 in 3.3 s and POV-Ray's own +AM1 +A0.03
+ * +R4 at twice the size 4.3e-5 in 5.1 s; thin_geometry 1.4e-4 in 4.3 s
+ * against 4.3e-4 in 4.8 s and POV-Ray's 1.7e-4 in 3.2 s.  At +A0.1 both
+ * erred more (1.0e-4 and 1.5e-4) for less CPU (5.1 and 4.0 s).  On media
+ * (160x120, forced) it did not pay: 5.5e-4 in 8.7 s against 1.3e-4 in
+ * 10.3 s, so it is for cheap samples only.
+ */
+enum { ACC_AA_FOR_FEW = 0, ACC_AA_FOR_EDGES = 1, ACC_AA_FOR_SPREAD = 2 };
+#define ACC_AA_SPREAD_DEPTH 3
+#define ACC_AA_SPREAD_THRESHOLD 0.03
+/*
+ * Such a render's pixel is charged its render pixels' spread (their mean's
+ * variance) divided by its range (the colour distance of its render
+ * pixels) over ACC_AA_SPREAD_RANGE, at least 1, not by the cells as for
+ * edges: over the subdivided pixels of soft_shadows and thin_geometry at
+ * 640x480 (the runs above, pixels binned by range) the true squared error
+ * over that spread was 0.22 and 0.16 at ranges 0.03 to 0.1, 0.084 and
+ * 0.053 at 0.1 to 0.3, 0.016 and 0.024 at 0.3 to 1 and 0.010 and 0.008
+ * above: about 0.012 / range on both, where the cells' 1/64 left the
+ * estimate at a quarter of the truth and under (an edge's error grows with
+ * its step, not with its square; noise below the threshold is spread the
+ * render did not subdivide).
+ */
+#define ACC_AA_SPREAD_RANGE 0.012
+/*
+ * The bit that marks a pixel folded from such a render (ACC_AA_FOR_SPREAD;
+ * it has ACC_AA_EDGE too).  Its samples are at the render pixels' centres
+ * and shared with no neighbour, so the hidden-edge term does not bound a
+ * step beside it by its render pixels' spread (ACC_AA_STEP_SD), only by
+ * the threshold: with the bound, soft_shadows at 640x480 and --target 1e-3
+ * was estimated at 0.56 times its true relMSE, the pixels whose render
+ * pixels agree within 0.03 (noise +AM1 left alone) at 0.02 to 0.39 times
+ * theirs; without it 0.95, those 0.73 to 2.4 (without ACC_AA_EDGE at all,
+ * 2.8).  thin_geometry stays at 0.57: 40% of its error is in lines no
+ * sample of the pixel or its neighbours has seen.
+ */
+#define ACC_AA_SPREAD_BIT 9
+
+/*
  * How many standard deviations of an edge render's pixel (its samples'
  * spread; after the render's fold onto the base sample, about its render
  * pixels', accum_merge_aa_file()) a step hidden inside it can be: one

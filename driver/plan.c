@@ -1188,13 +1188,21 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 	job->nextra = base->nextra;
 	if (r->scale == ACC_AA) {
 		/* POV-Ray's own adaptive antialiasing, jittered (accum.h) */
-		extra[job->nextra++] = "+AM2";
-		extra[job->nextra++] = r->frame > 0 ? "+A0.1" : "+A0.0";
 		static const char *const depth[] = { "+R1", "+R2", "+R3", "+R4", "+R5" };
+		/* +AM1's grid side for the same samples as +AM2's cells */
+		static const char *const side[] = { "+R1", "+R2", "+R4", "+R8", "+R16" };
 		_Static_assert(ACC_AA_DEPTH == 5, "a +R for every depth");
 		const int d = accum_aa_depth(r->depth);
-		extra[job->nextra++] = r->frame <= 0 ? "+R4"
-				       : depth[(d >= 1 && d <= ACC_AA_DEPTH ? d : ACC_AA_DEPTH_V1) - 1];
+		const int di = (d >= 1 && d <= ACC_AA_DEPTH ? d : ACC_AA_DEPTH_V1) - 1;
+		if (r->frame > 0 && r->edges == ACC_AA_FOR_SPREAD) {
+			extra[job->nextra++] = "+AM1";
+			extra[job->nextra++] = "+A0.03";	/* ACC_AA_SPREAD_THRESHOLD */
+			extra[job->nextra++] = side[di];
+		} else {
+			extra[job->nextra++] = "+AM2";
+			extra[job->nextra++] = r->frame > 0 ? "+A0.1" : "+A0.0";
+			extra[job->nextra++] = r->frame <= 0 ? "+R4" : depth[di];
+		}
 		extra[job->nextra++] = "+J";
 	} else if (grid) {
 		/* every pixel of the render supersampled (accum.h) */
@@ -1216,14 +1224,15 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *outputs)
 {
 	fprintf(f, "%s (pixels 0-based, inclusive; depth and edges: an antialiased render "
-		"in scale 2's place, its +R and 1 if taken for edges, else 0 0)\n", REGIONS_HEADER);
+		"in scale 2's place, its +R, and 1 if taken for edges, 2 for spread error (+AM1), "
+		"0 for a few pixels; else 0 0)\n", REGIONS_HEADER);
 	for (size_t k = 0; k < pl->nregions; k++)
 		if (strchr(outputs[k], '\n'))
 			return -1;	/* the format is one region per line */
 	for (size_t k = 0; k < pl->nregions; k++) {
 		const struct plan_region *r = &pl->regions[k];
 		fprintf(f, "%d\t%d\t%d\t%d\t%d\t%d\t%s\t%d\t%d\n", pass, r->x0, r->y0, r->x1,
-			r->y1, r->scale, outputs[k], r->depth, r->edges ? 1 : 0);
+			r->y1, r->scale, outputs[k], r->depth, r->edges);
 	}
 	return ferror(f) ? -1 : 0;
 }
@@ -1280,7 +1289,7 @@ static int regions_tail(char *s, struct plan_region *r)
 	if (*end || errno || d > ACC_AA_DEPTH)
 		return -1;
 	long e = strtol(t2 + 1, &end, 10);
-	if (*end || errno || (e != 0 && e != 1))
+	if (*end || errno || e < ACC_AA_FOR_FEW || e > ACC_AA_FOR_SPREAD)
 		return -1;
 	if ((d || e) && (r->scale != ACC_AA || !d))
 		return -1;	/* only an antialiased render has them */
@@ -1326,7 +1335,7 @@ int plan_regions_read(const char *path, struct plan_region **regions, char ***ou
 			if (tail)
 				errbuf_printf(err, errlen, "'%s' line %d: expected \"pass x0 y0 x1 y1 "
 					      "scale output depth edges\" separated by tabs (depth 0 "
-					      "to %d, edges 0 or 1; 0 0 unless the scale is 0)", path,
+					      "to %d, edges 0, 1 or 2; 0 0 unless the scale is 0)", path,
 					      lineno, ACC_AA_DEPTH);
 			else
 				errbuf_printf(err, errlen, "'%s' line %d: expected \"pass x0 y0 x1 y1 "

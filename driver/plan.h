@@ -149,9 +149,10 @@ struct plan_region {
 				 * ACC_AA_DEPTH; 0 for +R4, ACC_AA_DEPTH_V1, as a
 				 * regions file without the column), by which it is
 				 * folded (accum_merge_aa_file()) */
-	int edges;		/* such a render taken for edges (render.c's
-				 * edge rule), folded so
-				 * (accum_merge_aa_file()) */
+	int edges;		/* what such a render was taken for,
+				 * ACC_AA_FOR_FEW, _EDGES (render.c's edge
+				 * rule) or _SPREAD (+AM1, spread_am1()),
+				 * folded so (accum_merge_aa_file()) */
 };
 
 /* Pixels in r. */
@@ -224,7 +225,8 @@ void plan_release(struct plan *pl);
  * (r->frame ACC_GRID_FRAME) at twice base with +AM1 +A0.0 +R(scale/2)
  * +J0.75; when r->scale is ACC_AA at scale 1 with POV-Ray's antialiasing,
  * +AM2 +A0.0 +R4 +J, or at twice the size (r->frame ACC_GRID_FRAME) with
- * +AM2 +A0.1 +R3 +J (+R(r->depth) where that is set) (the options
+ * +AM2 +A0.1 +R3 +J (+R(r->depth) where that is set; taken for spread
+ * error, r->edges ACC_AA_FOR_SPREAD, +AM1 +A0.03 +R(2^(depth-1)) +J) (the options
  * appended after the user's, which come from base->extra).
  * base gives the scene,
  * full size, threads, defines, extra options, work directory and binary;

@@ -1654,7 +1654,8 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
 	for (size_t k = m; k < pl->nregions; k++) {
 		pl->regions[k].scale = ACC_AA;
 		pl->regions[k].frame = first ? ACC_GRID_FRAME : 0;
-		pl->regions[k].edges = first && *sparse == SPARSE_EDGES;
+		pl->regions[k].edges = first && *sparse == SPARSE_EDGES ? ACC_AA_FOR_EDGES
+									 : ACC_AA_FOR_FEW;
 		pl->regions[k].depth = !first ? 0 : pl->regions[k].edges ? ACC_AA_EDGE_DEPTH
 									: ACC_AA_DEPTH;
 	}
@@ -1678,8 +1679,9 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
  * aa_depth() covers the dearest.
  */
 #define EDGE_SAMPLES 100.0
-/* The pixels of region g of acc that count as edges for the cost above. */
-static long edge_pixels(const struct image *acc, const struct plan_region *g)
+/* The pixels of region g of acc that count as edges for the cost above:
+ * whose colour distance to a neighbour reaches t. */
+static long edge_pixels(const struct image *acc, const struct plan_region *g, double t)
 {
 	long e = 0;
 	for (int y = g->y0; y <= g->y1; y++)
@@ -1693,7 +1695,7 @@ static long edge_pixels(const struct image *acc, const struct plan_region *g)
 				const float *q = acc->px + ((size_t)ny * acc->w + nx) * ACC_NCH;
 				double dist = fabs((double)q[0] - o[0]) + fabs((double)q[1] - o[1]) +
 					      fabs((double)q[2] - o[2]);
-				edge = dist >= ACC_AA_THRESHOLD;
+				edge = dist >= t;
 			}
 			e += edge;
 		}
@@ -1745,7 +1747,7 @@ static void aa_depth(const struct run *r, struct plan *pl, const struct plan_par
 		for (size_t k = 0; k < pl->nregions; k++) {
 			if (!pl->regions[k].depth)
 				continue;
-			const long e = edge_pixels(&r->acc, &pl->regions[k]);
+			const long e = edge_pixels(&r->acc, &pl->regions[k], ACC_AA_THRESHOLD);
 			for (int t = 3; t <= d; t++) {
 				double c = edge_render_cost(pp, &pl->regions[k], r->acc.w, e, t);
 				sum[t] += c;
@@ -1758,6 +1760,69 @@ static void aa_depth(const struct run *r, struct plan *pl, const struct plan_par
 	for (size_t k = 0; k < pl->nregions; k++)
 		if (pl->regions[k].depth)
 			pl->regions[k].depth = d;
+}
+
+/*
+ * With --sampler auto, at the first refinement pass, where the error is
+ * spread (not sparse_error()), the scene has neither radiosity nor focal
+ * blur and its samples are cheap (r->cost_sample at most SPREAD_SAMPLE_S),
+ * the regions of scale 2 become POV-Ray's +AM1 +A0.03 +R4 +J at twice the
+ * size (ACC_AA_FOR_SPREAD in accum.h, which has the figures): on such
+ * scenes at 640x480 scale 2's regular 4 samples over most of the frame lost
+ * to POV-Ray's own antialiasing by 2.3 to 2.5 times, where its +AM1
+ * supersamples only the render pixels that differ from a neighbour.  The
+ * one_step() jitter takes the cheapest frames first (the frame at scale 4
+ * under JITTER_FRAME_S), so this serves larger images.  Dearer samples
+ * keep scale 2: on media (7.6e-6 s a sample) the render lost 4 times, and
+ * glossy_reflection (3.8e-6) gained at a target only for 2.7 times the CPU.
+ * The renders cost a sample a render pixel and SPREAD_EDGE_SAMPLES more
+ * at each pixel whose colour distance to a neighbour reaches the
+ * threshold (soft_shadows at 640x480: 5.1 CPU s for 281,600 pixels, 85,840
+ * of them such, at 0.87 microseconds a sample, 55 a pixel); the pass is
+ * planned as scale 2, so under a budget the renders are taken only where
+ * SPREAD_MARGIN times that cost fits what the pass may spend.  Returns how
+ * many regions it changed.
+ */
+#define SPREAD_SAMPLE_S 1.5e-6
+#define SPREAD_EDGE_SAMPLES 64.0
+#define SPREAD_MARGIN 1.25
+static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan_params *pp,
+			 double left, int *sparse)
+{
+	if (run_grid(r) != PLAN_GRID_LARGE || r->aa || r->npasses != 1 || r->radiosity ||
+	    r->focal || !(r->cost_sample <= SPREAD_SAMPLE_S) || !has_scale2(pl) ||
+	    sparse_error(r, sparse))
+		return 0;
+	if (r->budget > 0.0) {
+		double sum = 0.0, worst = 0.0;
+		for (size_t k = 0; k < pl->nregions; k++) {
+			const struct plan_region *g = &pl->regions[k];
+			if (g->scale != 2)
+				continue;
+			const double m = plan_region_map(pp, g, r->acc.w) / (double)plan_region_area(g);
+			const long e = edge_pixels(&r->acc, g, ACC_AA_SPREAD_THRESHOLD);
+			const double c = pp->cost_job +
+					 pp->cost_sample * m *
+						 (4.0 * (double)plan_region_area(g) +
+						  SPREAD_EDGE_SAMPLES * (double)e);
+			sum += c;
+			worst = c > worst ? c : worst;
+		}
+		if (!(SPREAD_MARGIN * sum <= pp->budget && SPREAD_MARGIN * worst <= left))
+			return 0;
+	}
+	size_t n = 0;
+	for (size_t k = 0; k < pl->nregions; k++) {
+		struct plan_region *g = &pl->regions[k];
+		if (g->scale != 2)
+			continue;
+		g->scale = ACC_AA;
+		g->frame = ACC_GRID_FRAME;
+		g->edges = ACC_AA_FOR_SPREAD;
+		g->depth = ACC_AA_SPREAD_DEPTH;
+		n++;
+	}
+	return n;
 }
 
 /*
@@ -2032,10 +2097,12 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			plan_release(&pl);
 			return PASS_STOP;
 		}
+		const double left = r->budget > 0.0 ? r->budget - elapsed(r) - reserve - lat : 0.0;
 		naa = choose_samplers(r, &pl, &sparse);
 		if (naa)
-			aa_depth(r, &pl, &pp,
-				   r->budget > 0.0 ? r->budget - elapsed(r) - reserve - lat : 0.0);
+			aa_depth(r, &pl, &pp, left);
+		else
+			naa = spread_am1(r, &pl, &pp, left, &sparse);
 		if (!early || prelaunch_cover(r, pass, &pl, &pre_idx))
 			break;
 		/* the early renders do not serve this plan: plan again for
@@ -2132,12 +2199,14 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	int depth = 0, edges = 0;
 	for (size_t k = 0; k < n; k++) {
 		depth = pl.regions[k].depth > depth ? pl.regions[k].depth : depth;
-		edges |= pl.regions[k].edges;
+		edges = pl.regions[k].edges > edges ? pl.regions[k].edges : edges;
 	}
 	if (naa)
-		progress(r, "pass %d: the estimated error sits %s: %zu region%s by POV-Ray's "
-			 "antialiasing in place of scale 2, depth %d", pass,
-			 edges ? "at edges" : "in few pixels", naa, naa == 1 ? "" : "s", depth);
+		progress(r, "pass %d: the estimated error %s: %zu region%s by POV-Ray's "
+			 "antialiasing (+AM%d) in place of scale 2, depth %d", pass,
+			 edges == ACC_AA_FOR_SPREAD ? "is spread and samples are cheap"
+			 : edges ? "sits at edges" : "sits in few pixels",
+			 naa, naa == 1 ? "" : "s", edges == ACC_AA_FOR_SPREAD ? 1 : 2, depth);
 	progress(r, "pass %d: %zu region%s, %ld pixels (%ld chosen), %.0f samples, about %.1f s",
 		 pass, n, n == 1 ? "" : "s", pl.pixels, pl.chosen_pixels, pl.samples,
 		 guess + r->latency);

@@ -49,11 +49,13 @@
 #             envelope stopped at scale 4, and povpress's dearer runs were
 #             measured against it, flattered: focal_blur at --budget 2 read
 #             0.46 against scale 4 and 1.08 against scale 6, README)
-#   aa2x      antialiasing at s = 2, box-averaged: +AM1 +A{0.1,0.03} +R3,
+#   aa2x      antialiasing at s = 2, box-averaged: +AM1 +A{0.1,0.03} +R{3,4},
 #             +AM2 +A{0.3,0.1} +R3, +AM2 +A0.1 +R4, each +J (since
 #             2026-12-04: on hdr_highlights +AM2 +A0.1 +R4 so had relMSE
 #             1.1e-4 in 1.07 CPU s, where the envelope without it had 5.2e-4
-#             at that CPU; README)
+#             at that CPU; +AM1 at +R4 since povpress renders spread error
+#             so, README); --quick +AM1 +A0.1 +R3, +AM1 +A0.03 +R4 and
+#             +AM2 +A0.3 +R3
 #   povpress  `povpress render` at --target 3e-3, 1e-3, 3e-4, 1e-4 and at
 #             --budget 2, 4, 8 seconds (with --target 1e-6), its defaults;
 #             each setting N times (--repeat N, 1 to 9; default 3, 1 with
@@ -163,14 +165,15 @@ if ((quick)); then
 	REF_S=9 CHK_S=5 TRD_S=3
 	THRESHOLDS=(0.3 0.03 0.0)
 	DEPTHS=(2 3)
-	AA2X=("+AM1 +A0.1 +R3" "+AM2 +A0.3 +R3")
+	AA2X=("+AM1 +A0.1 +R3" "+AM1 +A0.03 +R4" "+AM2 +A0.3 +R3")
 	TARGETS=(3e-3 1e-3)
 	PP_BUDGETS=(3)
 else
 	REF_S=15 CHK_S=9 TRD_S=5
 	THRESHOLDS=(0.3 0.1 0.03 0.01 0.0)
 	DEPTHS=(2 3 4)
-	AA2X=("+AM1 +A0.1 +R3" "+AM1 +A0.03 +R3" "+AM2 +A0.3 +R3" "+AM2 +A0.1 +R3" "+AM2 +A0.1 +R4")
+	AA2X=("+AM1 +A0.1 +R3" "+AM1 +A0.03 +R3" "+AM1 +A0.1 +R4" "+AM1 +A0.03 +R4"
+	      "+AM2 +A0.3 +R3" "+AM2 +A0.1 +R3" "+AM2 +A0.1 +R4")
 	TARGETS=(3e-3 1e-3 3e-4 1e-4)
 	PP_BUDGETS=(2 4 8)
 fi

@@ -1076,6 +1076,40 @@ static void test_merge_aa_edges(void **state)
 		if (depth >= ACC_AA_DEPTH_V1)
 			for (size_t i = 0; i < (size_t)5 * ACC_NCH; i++)
 				assert_true(memcmp(&few.px[i], &plain.px[i], sizeof(float)) == 0);
+		/* taken for spread error (+AM1): folded as for edges but for
+		 * its error, the spread over range / ACC_AA_SPREAD_RANGE (at
+		 * least 1), and marked ACC_AA_SPREAD_BIT besides */
+		struct image spr;
+		make_acc(&spr, 5, 1, flat_value);
+		assert_int_equal(accum_merge_aa_region(&spr, &big, 0, ACC_AA, depth,
+							 ACC_AA_FOR_SPREAD, 0, 0, 4, 0, 1, &folded,
+							 err, sizeof(err)), 0);
+		assert_int_equal(folded, 5);
+		for (int x = 0; x < 5; x++) {
+			const float *o = accpx(&acc, (size_t)x), *p = accpx(&spr, (size_t)x);
+			const double range = 3.0 * spread[x];
+			for (int ch = 0; ch < ACC_NCH; ch++)
+				if (ch != ACC_DIFF && ch != ACC_SCALES)
+					assert_true(memcmp(&o[ch], &p[ch], sizeof(float)) == 0);
+			assert_true(p[ACC_SCALES] == o[ACC_SCALES] + (float)(1u << ACC_AA_SPREAD_BIT));
+			const double k = o[ACC_SAMPLES] - 1.0;
+			double d = 0.0, v = 0.0;
+			for (int c = 0; c < 3; c++) {
+				const double m = 0.4 + 0.1 * c;
+				const double den = (double)p[c] * p[c] + METRICS_RELMSE_EPS;
+				d += (m - 0.5) * (m - 0.5) / den / 3.0;
+				v += spread[x] * spread[x] / 3.0 / 4.0 / den / 3.0;
+			}
+			const double full = (k * k + 1.0) / ((1.0 + k) * (1.0 + k)) * d;
+			const double div = range > ACC_AA_SPREAD_RANGE ? range / ACC_AA_SPREAD_RANGE
+								       : 1.0;
+			const double bound = v / div;
+			assert_close(p[ACC_DIFF], full < bound ? full : bound, 1e-4, 1e-12,
+				     "the spread fold's error: the spread over range / 0.012");
+			if (x >= 1 && x <= 3)	/* charged more than for edges */
+				assert_true(p[ACC_DIFF] > o[ACC_DIFF]);
+		}
+		image_release(&spr);
 		if (depth < ACC_AA_DEPTH)
 			image_release(&acc);	/* the deepest goes on below */
 		image_release(&few);
@@ -1130,6 +1164,12 @@ static void test_merge_aa_edges(void **state)
 	accpx(&two, 1)[ACC_SCALES] = accpx(&two, 0)[ACC_SCALES];
 	assert_close(accum_pixel_error(&two, 0, NAN, NULL, 0.0), small, 1e-4, 1e-15,
 		     "the hidden edge at most what the render pixels show");
+	/* ... but of +AM1's render for spread error (ACC_AA_SPREAD_BIT), whose
+	 * samples no neighbour shares, the threshold alone */
+	accpx(&two, 0)[ACC_SCALES] += (float)(1u << ACC_AA_SPREAD_BIT);
+	assert_close(accum_pixel_error(&two, 0, NAN, NULL, 0.0), cap, 1e-6, 1e-15,
+		     "+AM1's hidden edge at most the threshold");
+	accpx(&two, 0)[ACC_SCALES] -= (float)(1u << ACC_AA_SPREAD_BIT);
 	for (int c = 0; c < 3; c++)
 		accpx(&two, 0)[ACC_VAR_R + c] = 0.0f;
 	assert_true(accum_pixel_error(&two, 0, NAN, NULL, 0.0) == 0.0);
@@ -2282,14 +2322,15 @@ static void test_radiosity_trace(void **state)
 /* 7. The regions file round-trips; a bad line is reported with its number. */
 static void test_regions_file(void **state)
 {
-	struct plan_region rs[3] = {
+	struct plan_region rs[4] = {
 		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1, 0, 0, 0 },
 		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2, 0, 0, 0 },
-		{ 63, 47, 63, 47, ACC_AA, 1, 0.1, 0.3, ACC_GRID_FRAME, 3, 1 },
+		{ 63, 47, 63, 47, ACC_AA, 1, 0.1, 0.3, ACC_GRID_FRAME, 3, ACC_AA_FOR_EDGES },
+		{ 8, 0, 15, 7, ACC_AA, 1, 0.1, 0.3, ACC_GRID_FRAME, 3, ACC_AA_FOR_SPREAD },
 	};
 	static char o0[] = "r0.exr", o1[] = "a dir/with spaces/region 1.exr",
-		o2[] = "/tmp/x y\tz 4\t1.exr";
-	char *outs[3] = { o0, o1, o2 };
+		o2[] = "/tmp/x y\tz 4\t1.exr", o3[] = "p1-r3-aa.exr";
+	char *outs[4] = { o0, o1, o2, o3 };
 	struct plan pl;
 	struct plan_region *got;
 	char **gout, path[256], err[512];
@@ -2300,15 +2341,15 @@ static void test_regions_file(void **state)
 	(void)state;
 	memset(&pl, 0, sizeof(pl));
 	pl.regions = rs;
-	pl.nregions = 3;
+	pl.nregions = 4;
 	scratch(path, sizeof(path), "regions file.txt");
 	f = fopen(path, "w");
 	assert_non_null(f);
 	assert_int_equal(plan_regions_write(f, &pl, 7, outs), 0);
 	assert_int_equal(fclose(f), 0);
 	assert_int_equal(plan_regions_read(path, &got, &gout, &passes, &n, err, sizeof(err)), 0);
-	assert_int_equal(n, 3);
-	for (size_t k = 0; k < 3; k++) {
+	assert_int_equal(n, 4);
+	for (size_t k = 0; k < 4; k++) {
 		assert_int_equal(passes[k], 7);
 		assert_int_equal(got[k].x0, rs[k].x0);
 		assert_int_equal(got[k].y0, rs[k].y0);
@@ -2344,7 +2385,7 @@ static void test_regions_file(void **state)
 
 	/* line 3 has a letter for y0; then a line without an output; then,
 	 * under the header naming depth and edges, lines without them, with
-	 * a depth out of range, with edges on a scaled region, with edges 2 */
+	 * a depth out of range, with edges on a scaled region, with edges 3 */
 #define HDR "# povpress regions: pass x0 y0 x1 y1 scale output depth edges\n"
 	static const char *const bad[] = {
 		"# header\n1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\tx\t3\t3\t2\tb.exr\t0\t0\n",
@@ -2352,7 +2393,7 @@ static void test_regions_file(void **state)
 		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t1\n1\t0\t0\t3\t3\t2\tb.exr\n",
 		HDR "1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\t0\t3\t3\t0\tb.exr\t6\t0\n",
 		HDR "\n1\t0\t0\t3\t3\t2\ta.exr\t3\t1\n",
-		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t0\n1\t0\t0\t3\t3\t0\tb.exr\t4\t2\n",
+		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t0\n1\t0\t0\t3\t3\t0\tb.exr\t4\t3\n",
 		/* a sign; no header at all, old-format lines */
 		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t0\n1\t0\t0\t3\t3\t0\tb.exr\t+4\t0\n",
 		"# x\n1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\t0\t3\t3\t2\tb.exr\n",
@@ -2454,6 +2495,16 @@ static void test_plan_job(void **state)
 		plan_job(&base, &r, "out/a2.exr", &region, aextra, &job);
 		assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
 		assert_aa_options(&job, "+AM2", "+A0.1", want, "+J");
+		/* taken for spread error: +AM1 at the threshold, its grid's
+		 * side giving a pixel as many samples as +AM2's cells */
+		r.edges = ACC_AA_FOR_SPREAD;
+		snprintf(want, sizeof(want), "+R%d", 1 << (d - 1));
+		plan_job(&base, &r, "out/a3.exr", &region, aextra, &job);
+		assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
+		assert_aa_options(&job, "+AM1", "+A0.03", want, "+J");
+		assert_int_equal(4 * (1 << (d - 1)) * (1 << (d - 1)), accum_edge_cells(d));
+		assert_true(fabs(strtod("0.03", NULL) - ACC_AA_SPREAD_THRESHOLD) < 1e-12);
+		r.edges = ACC_AA_FOR_FEW;
 	}
 	r.depth = 0;
 	r.frame = 0;
