@@ -252,6 +252,19 @@ static double edge_cells(double range, double cells)
 	return range >= ACC_AA_THRESHOLD ? cells : pow(cells, log10(range / lo));
 }
 
+/* What the spread of a pixel's render pixels is divided by for the error
+ * of their mean, in a render taken for spread error (+AM1) whose render
+ * pixels' colour distance is range and whose subdivided pixels have that
+ * many cells (see ACC_AA_SPREAD_RANGE): range / ACC_AA_SPREAD_RANGE at
+ * ACC_AA_SPREAD_DEPTH's cells, in proportion to them at another depth,
+ * at least 1. */
+static double spread_division(double range, double cells)
+{
+	const double k = range / ACC_AA_SPREAD_RANGE * cells /
+			 (double)accum_edge_cells(ACC_AA_SPREAD_DEPTH);
+	return k > 1.0 ? k : 1.0;
+}
+
 /* Fold an antialiased render f times the image's size (see aa_worth()),
  * in scale 2's place at POV-Ray's depth `depth` (0: ACC_AA_DEPTH_V1, as a regions
  * file without the depth column was rendered), taken
@@ -304,7 +317,7 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			const double ec = first ? edge_cells(range, cells) : 1.0;
 			const double ek = !edge ? 1.0
 				: edges != ACC_AA_FOR_SPREAD ? ec
-				: range > ACC_AA_SPREAD_RANGE ? range / ACC_AA_SPREAD_RANGE : 1.0;
+				: spread_division(range, cells);
 			int k = first ? (ec > ACC_AA_FIRST ? (int)lround(ec) : ACC_AA_FIRST)
 				      : own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
 			/* taken for edges, the cells vary as the render pixels

@@ -124,7 +124,11 @@ static const char usage_options2[] =
 	"                        (less where a budget would not fit it); where it\n"
 	"                        is spread and the frame at\n"
 	"                        scale 4 takes less than 0.7 s on\n"
-	"                        the cores, as jitter; scale throughout where the\n"
+	"                        the cores, as jitter, or where it takes more and\n"
+	"                        a sample costs at most 1.5 microseconds, scale 2\n"
+	"                        as one render at twice the size with POV-Ray's\n"
+	"                        +AM1 +A0.03 +R4 +J (under a budget only where it\n"
+	"                        fits); scale throughout where the\n"
 	"                        file sets assumed_gamma other than 1, in whose\n"
 	"                        encoding POV-Ray's antialiasing averages), grid\n"
 	"                        (scales 4, 8 and 16 as renders at twice the size with\n"
@@ -1784,7 +1788,7 @@ static void aa_depth(const struct run *r, struct plan *pl, const struct plan_par
  * many regions it changed.
  */
 #define SPREAD_SAMPLE_S 1.5e-6
-#define SPREAD_EDGE_SAMPLES 64.0
+#define SPREAD_MIN_DEPTH 2
 #define SPREAD_MARGIN 1.25
 static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan_params *pp,
 			 double left, int *sparse)
@@ -1793,22 +1797,28 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 	    r->focal || !(r->cost_sample <= SPREAD_SAMPLE_S) || !has_scale2(pl) ||
 	    sparse_error(r, sparse))
 		return 0;
+	int d = ACC_AA_SPREAD_DEPTH;
 	if (r->budget > 0.0) {
-		double sum = 0.0, worst = 0.0;
+		double sum[ACC_AA_SPREAD_DEPTH + 1] = { 0.0 }, worst[ACC_AA_SPREAD_DEPTH + 1] = { 0.0 };
 		for (size_t k = 0; k < pl->nregions; k++) {
 			const struct plan_region *g = &pl->regions[k];
 			if (g->scale != 2)
 				continue;
 			const double m = plan_region_map(pp, g, r->acc.w) / (double)plan_region_area(g);
 			const long e = edge_pixels(&r->acc, g, ACC_AA_SPREAD_THRESHOLD);
-			const double c = pp->cost_job +
-					 pp->cost_sample * m *
-						 (4.0 * (double)plan_region_area(g) +
-						  SPREAD_EDGE_SAMPLES * (double)e);
-			sum += c;
-			worst = c > worst ? c : worst;
+			for (int t = SPREAD_MIN_DEPTH; t <= ACC_AA_SPREAD_DEPTH; t++) {
+				const double c = pp->cost_job +
+						 pp->cost_sample * m *
+							 (4.0 * (double)plan_region_area(g) +
+							  (double)accum_edge_cells(t) * (double)e);
+				sum[t] += c;
+				worst[t] = c > worst[t] ? c : worst[t];
+			}
 		}
-		if (!(SPREAD_MARGIN * sum <= pp->budget && SPREAD_MARGIN * worst <= left))
+		while (d >= SPREAD_MIN_DEPTH &&
+		       !(SPREAD_MARGIN * sum[d] <= pp->budget && SPREAD_MARGIN * worst[d] <= left))
+			d--;
+		if (d < SPREAD_MIN_DEPTH)
 			return 0;
 	}
 	size_t n = 0;
@@ -1819,7 +1829,7 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 		g->scale = ACC_AA;
 		g->frame = ACC_GRID_FRAME;
 		g->edges = ACC_AA_FOR_SPREAD;
-		g->depth = ACC_AA_SPREAD_DEPTH;
+		g->depth = d;
 		n++;
 	}
 	return n;
