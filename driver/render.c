@@ -1783,9 +1783,14 @@ static void aa_depth(const struct run *r, struct plan *pl, const struct plan_par
  * at each pixel whose colour distance to a neighbour reaches the
  * threshold (soft_shadows at 640x480: 5.1 CPU s for 281,600 pixels, 85,840
  * of them such, at 0.87 microseconds a sample, 55 a pixel); the pass is
- * planned as scale 2, so under a budget the renders are taken only where
- * SPREAD_MARGIN times that cost fits what the pass may spend.  Returns how
- * many regions it changed.
+ * planned as scale 2, so under a budget the renders are taken at +R4 or
+ * else +R2 (SPREAD_MIN_DEPTH; 16 samples a subdivided pixel) only where
+ * SPREAD_MARGIN times that cost fits what the pass may spend, priced at
+ * the base pass's measured cost of a sample, not the plan's power of two
+ * (soft_shadows' 0.87 microseconds went at times to 0.48, the +R2 renders
+ * took twice their price, and three of seven were lost at the deadline of
+ * --budget 2: relMSE 1.5e-3 to 2.7e-3 where scale 2 had 3.7e-4).  Returns
+ * how many regions it changed.
  */
 #define SPREAD_SAMPLE_S 1.5e-6
 #define SPREAD_MIN_DEPTH 2
@@ -1797,32 +1802,35 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 	    r->focal || !(r->cost_sample <= SPREAD_SAMPLE_S) || !has_scale2(pl) ||
 	    sparse_error(r, sparse))
 		return 0;
-	int d = ACC_AA_SPREAD_DEPTH;
-	if (r->budget > 0.0) {
-		double sum[ACC_AA_SPREAD_DEPTH + 1] = { 0.0 }, worst[ACC_AA_SPREAD_DEPTH + 1] = { 0.0 };
-		for (size_t k = 0; k < pl->nregions; k++) {
-			const struct plan_region *g = &pl->regions[k];
-			if (g->scale != 2)
-				continue;
-			const double m = plan_region_map(pp, g, r->acc.w) / (double)plan_region_area(g);
-			const long e = edge_pixels(&r->acc, g, ACC_AA_SPREAD_THRESHOLD);
-			for (int t = SPREAD_MIN_DEPTH; t <= ACC_AA_SPREAD_DEPTH; t++) {
-				const double c = pp->cost_job +
-						 pp->cost_sample * m *
-							 (4.0 * (double)plan_region_area(g) +
-							  (double)accum_edge_cells(t) * (double)e);
-				sum[t] += c;
-				worst[t] = c > worst[t] ? c : worst[t];
-			}
+	/* each scale-2 region's price at each depth, the pass's and its
+	 * dearest render's */
+	double *price = calloc(pl->nregions * (ACC_AA_SPREAD_DEPTH + 1), sizeof(*price));
+	if (!price)
+		return 0;
+	double sum[ACC_AA_SPREAD_DEPTH + 1] = { 0.0 }, worst[ACC_AA_SPREAD_DEPTH + 1] = { 0.0 };
+	for (size_t k = 0; k < pl->nregions; k++) {
+		const struct plan_region *g = &pl->regions[k];
+		if (g->scale != 2)
+			continue;
+		const double m = plan_region_map(pp, g, r->acc.w) / (double)plan_region_area(g);
+		const long e = edge_pixels(&r->acc, g, ACC_AA_SPREAD_THRESHOLD);
+		for (int t = SPREAD_MIN_DEPTH; t <= ACC_AA_SPREAD_DEPTH; t++) {
+			const double c = pp->cost_job +
+					 r->cost_sample_measured * m *
+						 (4.0 * (double)plan_region_area(g) +
+						  (double)accum_edge_cells(t) * (double)e);
+			price[k * (ACC_AA_SPREAD_DEPTH + 1) + t] = c;
+			sum[t] += c;
+			worst[t] = c > worst[t] ? c : worst[t];
 		}
+	}
+	int d = ACC_AA_SPREAD_DEPTH;
+	if (r->budget > 0.0)
 		while (d >= SPREAD_MIN_DEPTH &&
 		       !(SPREAD_MARGIN * sum[d] <= pp->budget && SPREAD_MARGIN * worst[d] <= left))
 			d--;
-		if (d < SPREAD_MIN_DEPTH)
-			return 0;
-	}
 	size_t n = 0;
-	for (size_t k = 0; k < pl->nregions; k++) {
+	for (size_t k = 0; k < pl->nregions && d >= SPREAD_MIN_DEPTH; k++) {
 		struct plan_region *g = &pl->regions[k];
 		if (g->scale != 2)
 			continue;
@@ -1830,8 +1838,13 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 		g->frame = ACC_GRID_FRAME;
 		g->edges = ACC_AA_FOR_SPREAD;
 		g->depth = d;
+		/* its price, for the progress display's guess and the
+		 * renders' timeout */
+		pl->cost += price[k * (ACC_AA_SPREAD_DEPTH + 1) + d] - g->cost;
+		g->cost = price[k * (ACC_AA_SPREAD_DEPTH + 1) + d];
 		n++;
 	}
+	free(price);
 	return n;
 }
 
@@ -2176,9 +2189,20 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		/* a minute plus ten times what the dearest region should cost:
 		 * a region at scale 16 can cost far more than the base pass */
 		double worst = 0.0;
-		for (size_t k = 0; k < n; k++)
-			if (pl.regions[k].cost > worst)
-				worst = pl.regions[k].cost;
+		for (size_t k = 0; k < n; k++) {
+			const struct plan_region *g = &pl.regions[k];
+			/* +AM2 in scale 2's place is planned as scale 2: its
+			 * modelled cost (at 640x480 Debian's advanced/bwstripe,
+			 * edges everywhere, took 21 CPU s a render planned at
+			 * 0.3 s, inside the timeout only by the image's size) */
+			const double gc =
+				g->scale == ACC_AA && g->frame > 0 && g->edges != ACC_AA_FOR_SPREAD
+					? edge_render_cost(&pp, g, r->acc.w,
+							   edge_pixels(&r->acc, g, ACC_AA_THRESHOLD),
+							   accum_aa_depth(g->depth))
+					: g->cost;
+			worst = gc > worst ? gc : worst;
+		}
 		po.timeout_s = 60.0 + 10.0 * worst;
 	}
 	po.on_done = on_done;
