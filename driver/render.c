@@ -1789,12 +1789,14 @@ static void aa_depth(const struct run *r, struct plan *pl, const struct plan_par
  * the base pass's measured cost of a sample, not the plan's power of two
  * (soft_shadows' 0.87 microseconds went at times to 0.48, the +R2 renders
  * took twice their price, and three of seven were lost at the deadline of
- * --budget 2: relMSE 1.5e-3 to 2.7e-3 where scale 2 had 3.7e-4).  Returns
- * how many regions it changed.
+ * --budget 2: relMSE 1.5e-3 to 2.7e-3 where scale 2 had 3.7e-4), with the
+ * pass's other renders (thin_geometry at --budget 2, one run in ten: two
+ * such renders beside four of scale 4, two renders lost, relMSE 1.1e-2
+ * where the others had 5.7e-4).  Returns how many regions it changed.
  */
 #define SPREAD_SAMPLE_S 1.5e-6
 #define SPREAD_MIN_DEPTH 2
-#define SPREAD_MARGIN 1.25
+#define SPREAD_MARGIN 1.5
 static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan_params *pp,
 			 double left, int *sparse)
 {
@@ -1810,8 +1812,11 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 	double sum[ACC_AA_SPREAD_DEPTH + 1] = { 0.0 }, worst[ACC_AA_SPREAD_DEPTH + 1] = { 0.0 };
 	for (size_t k = 0; k < pl->nregions; k++) {
 		const struct plan_region *g = &pl->regions[k];
-		if (g->scale != 2)
+		if (g->scale != 2) {	/* the pass's other renders, as planned */
+			for (int t = SPREAD_MIN_DEPTH; t <= ACC_AA_SPREAD_DEPTH; t++)
+				sum[t] += g->cost;
 			continue;
+		}
 		const double m = plan_region_map(pp, g, r->acc.w) / (double)plan_region_area(g);
 		const long e = edge_pixels(&r->acc, g, ACC_AA_SPREAD_THRESHOLD);
 		for (int t = SPREAD_MIN_DEPTH; t <= ACC_AA_SPREAD_DEPTH; t++) {
