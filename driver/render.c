@@ -1779,10 +1779,10 @@ static void aa_depth(const struct run *r, struct plan *pl, const struct plan_par
  * under JITTER_FRAME_S), so this serves larger images.  Dearer samples
  * keep scale 2: on media (7.6e-6 s a sample) the render lost 4 times, and
  * glossy_reflection (3.8e-6) gained at a target only for 2.7 times the CPU.
- * The renders cost a sample a render pixel and SPREAD_EDGE_SAMPLES more
+ * The renders cost a sample a render pixel and accum_edge_cells(depth) more
  * at each pixel whose colour distance to a neighbour reaches the
  * threshold (soft_shadows at 640x480: 5.1 CPU s for 281,600 pixels, 85,840
- * of them such, at 0.87 microseconds a sample, 55 a pixel); the pass is
+ * of them such, at 0.87 microseconds a sample, 55 a pixel at +R4); the pass is
  * planned as scale 2, so under a budget the renders are taken at +R4 or
  * else +R2 (SPREAD_MIN_DEPTH; 16 samples a subdivided pixel) only where
  * SPREAD_MARGIN times that cost fits what the pass may spend, priced at

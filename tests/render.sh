@@ -536,6 +536,44 @@ check "... resumed with --sampler scale, the run goes by it" \
 	-v --report "$T/tm.json" -- +WT1 2>"$T/tm.log" || bad "soft_shadows, target 0.5: render failed"
 check "... no pass, no choice: the report says auto" grep -q '"sampler_chosen": "auto"' "$T/tm.json"
 check "... and no line says otherwise" test "$(grep -c 'no scale 2' "$T/tm.log")" -eq 0
+# spread error where the frame at scale 4 is dearer than 0.7 s on the cores
+# but a sample costs at most 1.5 microseconds (thin_geometry at 320x240 on
+# one core, the cost of a sample pinned at 1e-6 s): the first pass renders
+# scale 2's regions as POV-Ray's +AM1 +A0.03 +R4 at twice the size (at
+# 640x480 on two cores, unpinned, relMSE 1.4e-4 where scale 2 had 4.3e-4)
+scene="$SC/thin_geometry.pov"
+if ref=$(S=9 W=320 H=240 reference "$scene"); then
+	for m in auto scale; do
+		taskset -c 0 "$PP" render "$scene" -o "$T/am1-$m.exr" -W 320 -H 240 --target 3e-3 \
+			--max-passes 1 --sampler $m --cost-sample 1e-6 -v --keep-workdir -- +WT1 \
+			2>"$T/am1-$m.log" ||
+			bad "thin_geometry 320x240 --sampler $m: render failed"
+	done
+	check "thin_geometry (spread, cheap samples, a dear frame): +AM1 in scale 2's place" \
+		grep -q "error is spread and samples are cheap: .* (+AM1) in place of scale 2, depth 3" \
+		"$T/am1-auto.log"
+	check "... its regions file says so (scale 0, depth 3, edges 2)" \
+		awk -F'\t' '$1 == 1 && $6 == 0 && $8 == 3 && $9 == 2 { f = 1 } END { exit !f }' \
+		"$T/am1-auto.exr.work/regions.tsv"
+	check "... and no scale-2 region" test -z "$(compgen -G "$T/am1-auto.exr.work/p01-*-s2.exr")"
+	a1=$(compgen -G "$T/am1-auto.exr.work/p01-*-aa.exr" | head -n 1)
+	check "... at twice the image's size" grep -q "640 x *480" <(iinfo "$a1" 2>&1)
+	# one pass: no scale above 2, so bit 9 is the largest a pixel can have
+	check "... its pixels marked (scales bit 9)" \
+		num 'a >= 512 && a < 1024' "$(oiiotool "$T/am1-auto.errors.exr" --ch scales \
+			--printstats 2>/dev/null | awk '/Max:/ { print $2; exit }')"
+	au=$(relmse "$T/am1-auto.exr" "$ref")
+	sc=$(relmse "$T/am1-scale.exr" "$ref")
+	est=$("$PP" compare "$T/am1-auto.exr" "$ref" --analysis "$T/am1-auto.errors.exr" |
+		awk '$1 == "est_relmse:" { print $2 }')
+	echo "# thin_geometry 320x240, one pass, one core: relMSE $au with +AM1 (estimated $est), $sc with scale"
+	check "... relMSE at most half of scale 2's" num 'a <= 0.5 * b' "$au" "$sc"
+	check "... its estimate within 3 times the true relMSE" num 'a <= 3 * b && 3 * a >= b' "$est" "$au"
+	check "--sampler scale: no antialiased region" \
+		test -z "$(compgen -G "$T/am1-scale.exr.work/p*-aa.exr")"
+else
+	bad "thin_geometry 320x240: reference render failed"
+fi
 
 # --- a smooth, nearly empty scene costs almost nothing beyond the base pass --
 "$PP" render "$SC/smooth_empty.pov" -o "$T/smooth.exr" -W $W -H $H -q --report "$T/smooth.json"
