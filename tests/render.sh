@@ -561,7 +561,7 @@ if ref=$(S=9 W=320 H=240 reference "$scene"); then
 	# one pass: no scale above 2, so bit 9 is the largest a pixel can have
 	check "... its pixels marked (scales bit 9)" \
 		num 'a >= 512 && a < 1024' "$(oiiotool "$T/am1-auto.errors.exr" --ch scales \
-			--printstats 2>/dev/null | awk '/Max:/ { print $2; exit }')"
+			--printstats 2>/dev/null | awk '/Max:/ { print $3; exit }')"
 	au=$(relmse "$T/am1-auto.exr" "$ref")
 	sc=$(relmse "$T/am1-scale.exr" "$ref")
 	est=$("$PP" compare "$T/am1-auto.exr" "$ref" --analysis "$T/am1-auto.errors.exr" |
