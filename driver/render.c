@@ -1801,6 +1801,18 @@ static void aa_depth(const struct run *r, struct plan *pl, const struct plan_par
 #define SPREAD_SAMPLE_S 1.5e-6
 #define SPREAD_MIN_DEPTH 2
 #define SPREAD_MARGIN 1.25
+/*
+ * At +R2 the render is taken only where the pass so spends at least this
+ * share of what it may.  Where it would spend less, passes follow it, and
+ * scale 2's smaller step lets them spread the budget over more pixels:
+ * under --budget 6 at 640x480, Debian's textures/noise_generator,
+ * textures/patterns/granite, textures/finishes/var_refl and advanced/
+ * swirlbox took it at shares of 0.30 to 0.48 and erred 1.04 to 1.66 times
+ * as much as with scale 2 (one run each, 2026-12-04 22:25 UTC), where
+ * soft_shadows and swirlbox under 3 s and thin_geometry under 2 s, at 0.52
+ * to 0.78, erred 0.23 to 0.57 times as much.
+ */
+#define SPREAD_R2_SHARE 0.4
 static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan_params *pp,
 			 double left, int *sparse)
 {
@@ -1834,10 +1846,13 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 		}
 	}
 	int d = ACC_AA_SPREAD_DEPTH;
-	if (r->budget > 0.0)
+	if (r->budget > 0.0) {
 		while (d >= SPREAD_MIN_DEPTH &&
 		       !(SPREAD_MARGIN * sum[d] <= pp->budget && SPREAD_MARGIN * worst[d] <= left))
 			d--;
+		if (d < ACC_AA_SPREAD_DEPTH && !(sum[d] >= SPREAD_R2_SHARE * pp->budget))
+			d = 0;	/* see SPREAD_R2_SHARE */
+	}
 	size_t n = 0;
 	for (size_t k = 0; k < pl->nregions && d >= SPREAD_MIN_DEPTH; k++) {
 		struct plan_region *g = &pl->regions[k];
