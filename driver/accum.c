@@ -1009,6 +1009,10 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 {
 	const float *o = acc->px + i * ACC_NCH, *nb[8];
 	const int own = o[ACC_SAMPLES] >= 4.0f, nn = neighbours8(acc, i, nb);
+	/* whether its samples' spread bounds a step it shares with a
+	 * neighbour of a render taken for edges (below): not for +AM1's
+	 * (ACC_AA_SPREAD_BIT), which shares no corners with its neighbours */
+	const int bounds = own && !accum_has_scale(acc, i, ACC_AA_SPREAD_BIT);
 	const int w = acc->w, px = (int)(i % (size_t)w), py = (int)(i / (size_t)w);
 	double best = 0.0;
 	for (int j = 0; j < nn; j++) {
@@ -1059,12 +1063,10 @@ static double hidden_edge(const struct image *acc, size_t i, int s)
 			/* between two pixels of a render taken for edges, at most
 			 * the threshold, and at most what this pixel's samples
 			 * spread over (ACC_AA_STEP_SD of their deviation: after
-			 * the render's fold, about its render pixels'), but not
-			 * for +AM1's (ACC_AA_SPREAD_BIT), which shares no corners
-			 * with its neighbours */
+			 * the render's fold, about its render pixels') where that
+			 * bounds it (`bounds`, above) */
 			double cap = ACC_AA_THRESHOLD / 3.0;
-			if (seen && own && !accum_has_scale(acc, i, ACC_AA_SPREAD_BIT) &&
-			    ACC_AA_STEP_SD * sqrt(o[ACC_VAR_R + c]) < cap)
+			if (seen && bounds && ACC_AA_STEP_SD * sqrt(o[ACC_VAR_R + c]) < cap)
 				cap = ACC_AA_STEP_SD * sqrt(o[ACC_VAR_R + c]);
 			if (seen && fabs(dh) > cap)
 				dh = d > 0.0 ? cap : -cap;

@@ -1706,17 +1706,24 @@ static long edge_pixels(const struct image *acc, const struct plan_region *g, do
 	return e;
 }
 
+/* The CPU seconds of an antialiased render in scale 2's place over region
+ * g of an image w pixels wide, at cost_sample a sample (the cost map's
+ * mean over g scaling it): its corners, ACC_GRID_FRAME^2 samples a pixel,
+ * and `more` samples at each of its e edge pixels (edge_pixels()). */
+static double aa_render_cost(const struct plan_params *pp, const struct plan_region *g, int w,
+			     double cost_sample, long e, double more)
+{
+	const double f2 = (double)ACC_GRID_FRAME * ACC_GRID_FRAME;
+	const double m = plan_region_map(pp, g, w) / (double)plan_region_area(g);
+	return pp->cost_job + cost_sample * m * (f2 * (double)plan_region_area(g) + more * (double)e);
+}
+
 /* The cost above of region g, of an image w pixels wide, with e edge
  * pixels (edge_pixels()), at depth d. */
 static double edge_render_cost(const struct plan_params *pp, const struct plan_region *g, int w,
 			       long e, int d)
 {
-	const double f2 = (double)ACC_GRID_FRAME * ACC_GRID_FRAME;
-	/* the region's cost a sample, the cost map's mean */
-	const double m = plan_region_map(pp, g, w) / (double)plan_region_area(g);
-	return pp->cost_job + pp->cost_sample * m *
-				      (f2 * (double)plan_region_area(g) +
-				       ldexp(EDGE_SAMPLES, d - 4) * (double)e);
+	return aa_render_cost(pp, g, w, pp->cost_sample, e, ldexp(EDGE_SAMPLES, d - 4));
 }
 
 /*
@@ -1833,13 +1840,10 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 				sum[t] += g->cost;
 			continue;
 		}
-		const double m = plan_region_map(pp, g, r->acc.w) / (double)plan_region_area(g);
 		const long e = edge_pixels(&r->acc, g, ACC_AA_SPREAD_THRESHOLD);
 		for (int t = SPREAD_MIN_DEPTH; t <= ACC_AA_SPREAD_DEPTH; t++) {
-			const double c = pp->cost_job +
-					 r->cost_sample_measured * m *
-						 (4.0 * (double)plan_region_area(g) +
-						  (double)accum_edge_cells(t) * (double)e);
+			const double c = aa_render_cost(pp, g, r->acc.w, r->cost_sample_measured, e,
+							accum_edge_cells(t));
 			price[k * (ACC_AA_SPREAD_DEPTH + 1) + t] = c;
 			sum[t] += c;
 			worst[t] = c > worst[t] ? c : worst[t];
