@@ -1741,17 +1741,27 @@ static double edge_render_cost(const struct plan_params *pp, const struct plan_r
  * for 11,416 pixels) and by
  * edge_render_cost() at 1.35 core-s, its dearest render 0.68 s, ran past
  * the deadline 1.56 s on and lost that render: relMSE 9.0e-4 against
- * +R3's 2.8e-5.  The regions keep scale 2's cost for the plan (and the
- * cost map learns nothing from them: learn_costs()).
+ * +R3's 2.8e-5.  Where even +R3's cost (without the margin) is more than
+ * the pass may spend, or its dearest render than the time left, the
+ * regions go back to the scale 2 they were planned as, and the count of
+ * those kept is returned (0), *price set to +R3's cost: Debian's
+ * advanced/bwstripe at 640x480 under --budget 3, every pixel an edge, ran
+ * +R3 priced at 8.2 core-s against a share of 3.7, all four renders were
+ * stopped at the deadline and the image was the base pass's, relMSE 0.40;
+ * so, 0.026 (scale 2, then scale 4 at the stripes; POV-Ray alone at that
+ * CPU 0.0067 by resolution scaling, 2026-12-04).  The regions keep scale
+ * 2's cost for the plan (and the cost map learns nothing from them:
+ * learn_costs()).
  */
 #define EDGE_MARGIN 2.0
-static void aa_depth(const struct run *r, struct plan *pl, const struct plan_params *pp,
-		     double left)
+static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_params *pp,
+		       double left, double *price)
 {
 	int d = 0;
+	*price = 0.0;
 	for (size_t k = 0; k < pl->nregions; k++)
 		d = pl->regions[k].depth > d ? pl->regions[k].depth : d;
-	if (r->budget > 0.0 && d > 3) {
+	if (r->budget > 0.0 && d >= 3) {
 		/* the pass's cost and its dearest render at each depth from 3
 		 * to d, each region's edges counted once */
 		double sum[ACC_AA_DEPTH + 1] = { 0.0 }, worst[ACC_AA_DEPTH + 1] = { 0.0 };
@@ -1767,10 +1777,27 @@ static void aa_depth(const struct run *r, struct plan *pl, const struct plan_par
 		}
 		while (d > 3 && !(EDGE_MARGIN * sum[d] <= pp->budget && EDGE_MARGIN * worst[d] <= left))
 			d--;
+		if (!(sum[3] <= pp->budget && worst[3] <= left)) {
+			*price = sum[3];
+			d = 0;
+		}
 	}
-	for (size_t k = 0; k < pl->nregions; k++)
-		if (pl->regions[k].depth)
-			pl->regions[k].depth = d;
+	size_t n = 0;
+	for (size_t k = 0; k < pl->nregions; k++) {
+		struct plan_region *g = &pl->regions[k];
+		if (!g->depth)
+			continue;
+		if (d >= 3) {
+			g->depth = d;
+			n++;
+		} else {	/* back to the scale 2 it was planned as */
+			g->scale = 2;
+			g->frame = 0;
+			g->edges = 0;
+			g->depth = 0;
+		}
+	}
+	return n;
 }
 
 /*
@@ -2150,9 +2177,14 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		}
 		const double left = r->budget > 0.0 ? r->budget - elapsed(r) - reserve - lat : 0.0;
 		naa = choose_samplers(r, &pl, &sparse);
-		if (naa)
-			aa_depth(r, &pl, &pp, left);
-		else
+		if (naa) {
+			double price;
+			naa = aa_depth(r, &pl, &pp, left, &price);
+			if (!naa)
+				progress(r, "pass %d: antialiasing at edges would not fit the "
+					 "budget even at +R3 (about %.1f core-s): scale 2", pass,
+					 price);
+		} else
 			naa = spread_am1(r, &pl, &pp, left, &sparse);
 		if (!early || prelaunch_cover(r, pass, &pl, &pre_idx))
 			break;
