@@ -979,8 +979,11 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	qsort(cand, nc, sizeof(*cand), by_score);
 
 	/* take pixels at their next scales until the predicted error meets
-	 * target * margin or the samples alone would exceed the budget */
-	const double goal = p->target * p->margin * (double)npx;
+	 * target * margin, or near the target what PLAN_REALIZED asks, or
+	 * the samples alone would exceed the budget */
+	const double near = out->est_relmse - (out->est_relmse - p->target) / PLAN_REALIZED;
+	const double goal_px = near > p->target * p->margin ? near : p->target * p->margin;
+	const double goal = goal_px * (double)npx;
 	const double cap = p->budget > 0.0 ? p->budget : INFINITY;
 	double total0 = out->est_relmse * (double)npx, spend0 = 0.0;
 	/* the dearest gain taken, seconds a unit: what a pixel a rectangle
@@ -1139,7 +1142,7 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	if (out->est_after < 0.0)
 		out->est_after = 0.0;
 	out->outcome = PLAN_REFINE;
-	if (p->budget > 0.0 && out->est_after > p->target * p->margin &&
+	if (p->budget > 0.0 && out->est_after > goal_px &&
 	    out->est_relmse - out->est_after < p->min_pass_gain * out->est_relmse) {
 		out->outcome = PLAN_LITTLE_GAIN;
 		free(out->regions);

@@ -240,6 +240,8 @@ struct pass_rec {
 	long pixels;
 	double samples;
 	double est_relmse;
+	double planned_relmse;	/* the plan's prediction of est_relmse (NaN: none,
+				 * or a pass resumed; not in progress.txt) */
 	double analysis_s;
 	int prelaunched;	/* regions taken from renders started early */
 };
@@ -459,7 +461,7 @@ static int load_progress(struct run *r, char *err, size_t errlen)
 			ok |= 1;
 			continue;
 		}
-		struct pass_rec p = {0};
+		struct pass_rec p = { .planned_relmse = NAN };
 		if (sscanf(line, "pass %d %lf %lf %lf %d %d %d %ld %lf %lf %lf", &p.pass, &p.wall_s,
 			   &p.cpu_s, &p.driver_cpu_s, &p.invocations, &p.regions, &p.failed,
 			   &p.pixels, &p.samples, &p.est_relmse, &p.analysis_s) == 11) {
@@ -789,9 +791,14 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 		fprintf(f, "    {\"pass\": %d, \"wall_s\": %.3f, \"cpu_s\": %.3f, "
 			"\"driver_cpu_s\": %.3f, \"invocations\": %d, \"regions\": %d, "
 			"\"failed\": %d, \"pixels\": %ld, \"samples\": %.0f, "
-			"\"est_relmse\": %.6g, \"analysis_s\": %.3f, \"prelaunched\": %d}%s\n",
+			"\"est_relmse\": %.6g, ",
 			p->pass, p->wall_s, p->cpu_s, p->driver_cpu_s, p->invocations, p->regions,
-			p->failed, p->pixels, p->samples, p->est_relmse, p->analysis_s,
+			p->failed, p->pixels, p->samples, p->est_relmse);
+		if (isfinite(p->planned_relmse))
+			fprintf(f, "\"planned_relmse\": %.6g, ", p->planned_relmse);
+		else
+			fputs("\"planned_relmse\": null, ", f);
+		fprintf(f, "\"analysis_s\": %.3f, \"prelaunched\": %d}%s\n", p->analysis_s,
 			p->prelaunched, k + 1 < r->npasses ? "," : "");
 		tw += p->wall_s;
 		tc += p->cpu_s;
@@ -1532,7 +1539,7 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 		r->cost_sample = r->cost_sample_measured = r->user_cost_sample;
 		r->rad_rays = 0.0;
 	}
-	struct pass_rec p = {0};
+	struct pass_rec p = { .planned_relmse = NAN };
 	p.pass = 0;
 	p.wall_s = now_s() - t;
 	p.cpu_s = res.cpu_s;
@@ -2372,6 +2379,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	p.wall_s = now_s() - t;
 	p.driver_cpu_s = self_cpu() - c;
 	p.est_relmse = NAN;
+	p.planned_relmse = pl.est_after;
 	if (add_pass(r, &p)) {
 		errbuf_printf(err, errlen, "out of memory");
 		goto out;

@@ -1525,6 +1525,38 @@ static void test_plan_make(void **state)
 	plan_params_init(&p);
 	image_release(&in->acc);
 
+	/* near the target a pass takes off what is missing over
+	 * PLAN_REALIZED, not down to target * margin: the block's 30 pixels
+	 * of equal error e, each gaining 4/5 of it at scale 2, the estimate
+	 * 5% above the target: (1 - 1/1.05) 30 / 0.8 / 0.8 = 2.2, so 3
+	 * pixels (with the margin alone 13) */
+	plan_input(in, block, 1, 0.25f);
+	const double e30 = 30.0 * (0.25 / 0.26) / (PW * PH);
+	p.target = e30 / 1.05;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	assert_int_equal(pl.chosen_pixels, 3);
+	assert_true(pl.est_after <= p.target);
+	plan_release(&pl);
+	/* ... far above it, down to target * margin: the estimate 3 times
+	 * the target, (1 - 0.7 / 3) 30 / 0.8 = 28.75, so 29 */
+	p.target = e30 / 3.0;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	assert_int_equal(pl.chosen_pixels, 29);
+	plan_release(&pl);
+	/* ... and under a budget a pass that meets the target by taking off
+	 * less than min_pass_gain of the estimate (one pixel, 2.7%, where
+	 * 0.5% is missing; 5% asked) still runs */
+	p.target = e30 / 1.005;
+	p.budget = 1.0;
+	p.cost_job = 0.0;
+	p.min_pass_gain = 0.05;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	assert_true(pl.est_after <= p.target);
+	assert_true(pl.est_relmse - pl.est_after < p.min_pass_gain * pl.est_relmse);
+	plan_release(&pl);
+	plan_params_init(&p);
+	image_release(&in->acc);
+
 	/* every scale already sampled everywhere, large error */
 	static const int all[1][4] = { { 0, 0, PW - 1, PH - 1 } };
 	plan_input(in, all, 1, 0.25f);
