@@ -27,11 +27,12 @@
  * pass plans for the estimate less (estimate - target) / PLAN_REALIZED
  * where that is above target * margin, so that near the target it takes
  * off what is missing and a little more rather than 30% of the estimate.
- * Over 49 refinement passes of the bundled scenes at 320x240 (targets 3e-3,
- * 1e-3 and 3e-4, one run each, the reports' est_relmse against
- * planned_relmse, 2026-12-04) the estimate fell by 0.89 to 11.7 times the
- * predicted fall, 0.98 to 1.24 in all but media's (0.89, 0.91) and two
- * passes after a first that found stars and highlights whole (4.7, 11.7).
+ * Over 62 refinement passes of the eleven bundled scenes with visible
+ * error at 320x240 (targets 3e-3, 1e-3 and 3e-4, one run each, the
+ * reports' est_relmse against planned_relmse, 2026-12-04) the estimate
+ * fell by 0.89 to 11.7 times the predicted fall: 0.98 to 1.43 but for
+ * media's second passes (0.89 to 0.91) and five second passes after a
+ * first that found stars and highlights whole (4.7 to 11.7).
  * With the margin alone a pass that began just above the target planned
  * for 0.7 of it, and its rectangles took the pixels around along:
  * glossy_reflection at 640x480, --target 1e-3, began its third pass at an

@@ -677,8 +677,9 @@ check "... merge folds it to render's accumulation, bit for bit" \
 # --- ... and one taken for edges, at +R4 and at +R3 (regions.tsv's depth and
 # edges columns), as render does; a file without them still merges ------------
 # still_life at 160x120 takes its first pass for edges; costing a sample at
-# 4e-5 s under a 4 s budget, +R3 (+R4 at 1e-5 s, +R3 from 2e-5 s by hand,
-# 2026-12-04)
+# 2e-5 s under a 4 s budget, +R3 (+R4 at 1e-5 s, +R3 at 2e-5 and 2.5e-5 s,
+# scale 2 from 3e-5 s, where +R3's price 1.5 times over passes the share,
+# by hand, 2026-12-04)
 # one_pass TAG SCENE [OPTION ...]: render SCENE's base pass and one pass at
 # 160x120 into $T/TAG.work, then merge its regions.tsv onto the base pass
 # into $T/TAG-acc1.exr
@@ -703,7 +704,7 @@ folds_alike() {
 }
 for n in r4 r3; do
 	o=()
-	[[ $n == r3 ]] && o=(--budget 4 --cost-job 0.05 --cost-sample 4e-5)
+	[[ $n == r3 ]] && o=(--budget 4 --cost-job 0.05 --cost-sample 2e-5)
 	one_pass "ae$n" "$SC/still_life.pov" "${o[@]}"
 	check "still_life, one pass ($n): render, then merge its regions.tsv: runs" test $? -eq 0
 	check "... every region antialiased for edges at ${n/r/+R} (scale 0, depth ${n#r}, edges 1)" \
