@@ -1749,9 +1749,10 @@ static double edge_render_cost(const struct plan_params *pp, const struct plan_r
  * edge_render_cost() at 1.35 core-s, its dearest render 0.68 s, ran past
  * the deadline 1.56 s on and lost that render: relMSE 9.0e-4 against
  * +R3's 2.8e-5.  Where even EDGE_R3_MARGIN times +R3's cost is more than
- * the pass may spend, or its dearest render than the time left, the
- * regions go back to the scale 2 they were planned as, and the count of
- * those kept is returned (0), *price set to +R3's cost: Debian's
+ * the pass may spend, or its dearest render than the time left, *price is
+ * set to +R3's cost and aa_some() keeps +R3 where it fits, the other
+ * regions going back to the scale 2 they were planned as; the count of
+ * those at +R3 is returned.  Debian's
  * advanced/bwstripe at 640x480 under --budget 3, every pixel an edge, ran
  * +R3 priced at 8.2 core-s against a share of 3.7, all four renders were
  * stopped at the deadline and the image was the base pass's, relMSE 0.40;
@@ -1764,12 +1765,91 @@ static double edge_render_cost(const struct plan_params *pp, const struct plan_r
  * renders at 2.9 core-s for a share of 3.0, a quarter of a 1280x960 frame
  * took 0.98 CPU s where its corners alone took 0.50 (the subdivided
  * samples, at its lamps, twice as dear), and 4 of 7 renders were lost
- * (relMSE 1.6e-3; with the margin, scale 2, 1.1e-3 in two runs).  The
+ * (relMSE 1.6e-3; all at scale 2, 1.1e-3 in two runs; by aa_some(), 7.2e-4
+ * in three, none lost).  The
  * regions keep scale 2's cost for the plan (and the cost map learns
  * nothing from them: learn_costs()).
  */
 #define EDGE_MARGIN 2.0
 #define EDGE_R3_MARGIN 1.5
+/* aa_depth() where +R3 over all of a plan's antialiased regions does not
+ * fit: the regions whose +R3 costs least more than their scale 2 keep it
+ * while EDGE_R3_MARGIN times the pass (those at +R3, the rest at the
+ * scale 2 they were planned as, pl's other regions aside) fits pp->budget
+ * and their render `left`; the rest go back to scale 2, before the
+ * antialiased ones (which are folded last: choose_samplers()).  Returns
+ * how many keep +R3.  hdr_highlights at 640x480 under --budget 3: its
+ * three lamps' renders, of 169 to 289 pixels, at +R3; the four quarters
+ * of its floor at scale 2. */
+static size_t aa_some(const struct run *r, struct plan *pl, const struct plan_params *pp,
+		      double left)
+{
+	const size_t n = pl->nregions;
+	double *extra = malloc(n * sizeof(*extra)), *c3 = malloc(n * sizeof(*c3));
+	unsigned char *keep = calloc(n, 1);
+	struct plan_region *to = malloc(n * sizeof(*to));
+	size_t kept = 0;
+	if (extra && c3 && keep && to) {
+		double total = 0.0;
+		for (size_t k = 0; k < n; k++) {
+			const struct plan_region *g = &pl->regions[k];
+			if (!g->depth)
+				continue;
+			c3[k] = edge_render_cost(pp, g, r->acc.w,
+						 edge_pixels(&r->acc, g, ACC_AA_THRESHOLD), 3);
+			extra[k] = c3[k] - g->cost;
+			total += g->cost;
+		}
+		for (;;) {	/* the least extra first; n is at most 2 max_regions */
+			size_t b = n;
+			for (size_t k = 0; k < n; k++)
+				if (pl->regions[k].depth && !keep[k] &&
+				    (b == n || extra[k] < extra[b]))
+					b = k;
+			if (b == n || !(EDGE_R3_MARGIN * (total + extra[b]) <= pp->budget &&
+					EDGE_R3_MARGIN * c3[b] <= left))
+				break;
+			keep[b] = 1;
+			total += extra[b];
+		}
+		/* the plan's scaled regions, those back at scale 2, then those
+		 * kept at +R3, each in their order */
+		size_t m = 0;
+		for (int part = 0; part < 3; part++)
+			for (size_t k = 0; k < n; k++) {
+				const struct plan_region *g = &pl->regions[k];
+				if (part != (!g->depth ? 0 : keep[k] ? 2 : 1))
+					continue;
+				to[m] = *g;
+				if (part == 1) {
+					to[m].scale = 2;
+					to[m].frame = 0;
+					to[m].edges = 0;
+					to[m].depth = 0;
+				} else if (part == 2) {
+					to[m].depth = 3;
+					kept++;
+				}
+				m++;
+			}
+		memcpy(pl->regions, to, n * sizeof(*to));
+	} else {	/* out of memory: all back at scale 2, where they are */
+		for (size_t k = 0; k < n; k++) {
+			struct plan_region *g = &pl->regions[k];
+			if (g->depth) {
+				g->scale = 2;
+				g->frame = 0;
+				g->edges = 0;
+				g->depth = 0;
+			}
+		}
+	}
+	free(extra);
+	free(c3);
+	free(keep);
+	free(to);
+	return kept;
+}
 static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_params *pp,
 		       double left, double *price)
 {
@@ -1795,24 +1875,15 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
 			d--;
 		if (!(EDGE_R3_MARGIN * sum[3] <= pp->budget && EDGE_R3_MARGIN * worst[3] <= left)) {
 			*price = sum[3];
-			d = 0;
+			return aa_some(r, pl, pp, left);
 		}
 	}
 	size_t n = 0;
-	for (size_t k = 0; k < pl->nregions; k++) {
-		struct plan_region *g = &pl->regions[k];
-		if (!g->depth)
-			continue;
-		if (d >= 3) {
-			g->depth = d;
+	for (size_t k = 0; k < pl->nregions; k++)
+		if (pl->regions[k].depth) {
+			pl->regions[k].depth = d;
 			n++;
-		} else {	/* back to the scale 2 it was planned as */
-			g->scale = 2;
-			g->frame = 0;
-			g->edges = 0;
-			g->depth = 0;
 		}
-	}
 	return n;
 }
 
@@ -2195,11 +2266,12 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		naa = choose_samplers(r, &pl, &sparse);
 		if (naa) {
 			double price;
+			const size_t all = naa;
 			naa = aa_depth(r, &pl, &pp, left, &price);
-			if (!naa)
-				progress(r, "pass %d: antialiasing at edges would not fit the "
-					 "budget even at +R3 (about %.1f core-s): scale 2", pass,
-					 price);
+			if (price > 0.0)
+				progress(r, "pass %d: antialiasing in all %zu regions would not "
+					 "fit the budget even at +R3 (about %.1f core-s): %zu at "
+					 "+R3, the rest at scale 2", pass, all, price, naa);
 		} else
 			naa = spread_am1(r, &pl, &pp, left, &sparse);
 		if (!early || prelaunch_cover(r, pass, &pl, &pre_idx))

@@ -434,6 +434,22 @@ if ref=$(W=160 H=120 reference "$scene"); then
 else
 	bad "hdr_highlights: reference render failed"
 fi
+# past_share TAG SCENE BUDGET COST KEPT WHAT: one pass of SCENE at 160x120
+# under --budget BUDGET with a sample costing COST s, where +R3 over all of
+# the pass's antialiased regions is priced past its share; check that the
+# log says so, with KEPT (a grep pattern) of them at +R3, and that no render
+# was lost at the deadline; the work directory is $T/TAG.exr.work
+past_share() {
+	local tag=$1 scene=$2 budget=$3 cost=$4 kept=$5 what=$6
+	"$PP" render "$scene" -o "$T/$tag.exr" -W 160 -H 120 --budget "$budget" --target 1e-6 -v \
+		--max-passes 1 --cost-sample "$cost" --keep-workdir -- +WT1 2>"$T/$tag.log" ||
+		bad "$what: render failed"
+	check "$what: +R3 priced past the pass's share, and it says so" \
+		grep -q "would not fit the budget even at +R3 (about [0-9.]* core-s): $kept at +R3, the rest at scale 2" \
+		"$T/$tag.log"
+	check "... and no render lost at the deadline" \
+		test "$(grep -c "stopped at the budget's end" "$T/$tag.log")" -eq 0
+}
 # still_life's error is its edges: after the base pass at 160x120 the
 # largest 5% of the pixels' estimates hold 0.77 of it, and the first pass
 # renders POV-Ray's antialiasing in scale 2's place there too, at depth 4
@@ -469,20 +485,14 @@ if ref=$(S=9 W=160 H=120 reference "$scene"); then
 	# at the deadline, and the image was the base pass's, relMSE 0.40 where
 	# scale 2 then scale 4 have 0.026); pinned at 2^-15 s a sample, +R3 at
 	# 3.9 core-s for 1.1
-	"$PP" render "$scene" -o "$T/sl-b1.exr" -W 160 -H 120 --budget 1.2 --target 1e-6 -v \
-		--max-passes 1 --cost-sample 3.0517578125e-05 --keep-workdir -- +WT1 2>"$T/sl-b1.log" ||
-		bad "still_life --budget 1.2, 2^-15 s a sample: render failed"
-	check "still_life --budget 1.2, +R3 priced past the pass's share: scale 2, and says so" \
-		grep -q "would not fit the budget even at +R3 (about [0-9.]* core-s): scale 2" \
-		"$T/sl-b1.log"
+	past_share sl-b1 "$scene" 1.2 3.0517578125e-05 0 \
+		"still_life --budget 1.2, 2^-15 s a sample (no region kept at +R3)"
 	check "... its regions file: pass 1 at scale 2 alone" \
 		awk -F'\t' '$1 == 1 { k++; if ($6 != 2) b = 1 } END { exit b || !k }' \
 		"$T/sl-b1.exr.work/regions.tsv"
 	check "... its renders at scale 2, none antialiased" \
 		test -n "$(compgen -G "$T/sl-b1.exr.work/p01-*-s2.exr")" -a \
 		-z "$(compgen -G "$T/sl-b1.exr.work/p01-*-aa.exr")"
-	check "... and no render lost at the deadline" \
-		test "$(grep -c "stopped at the budget's end" "$T/sl-b1.log")" -eq 0
 	# folded as taken for edges, the pass's estimate is near the truth
 	# (measured 3.1e-5 for 1.4e-5 against this reference; at +R3, the
 	# cells' variance the base sample's, 7.5e-5 for 2.8e-5; charged the
@@ -496,6 +506,17 @@ if ref=$(S=9 W=160 H=120 reference "$scene"); then
 else
 	bad "still_life: reference render failed"
 fi
+# ... and where +R3 over all the regions would not fit but over some it
+# would, those whose +R3 costs least more than their scale 2 keep it, the
+# rest go back to scale 2, folded before them (hdr_highlights at 160x120,
+# 3e-5 s a sample, 2 s: its lamps and a strip at +R3, its floor at scale 2;
+# at 640x480 under --budget 3, unpinned, relMSE 7.2e-4 in three runs, where
+# all at scale 2 had 1.1e-3 and all at +R3 1.6e-3, renders lost)
+past_share hs "$SC/hdr_highlights.pov" 2 3e-5 "[1-9][0-9]*" \
+	"hdr_highlights --budget 2, 3e-5 s a sample (some regions kept at +R3)"
+check "... its regions file: pass 1 at scale 2 and at +R3 (scale 0, depth 3), those last" \
+	awk -F'\t' '$1 == 1 { if ($6 == 2) { s++; if (a) b = 1 } else if ($6 == 0 && $8 == 3) a++;
+		else b = 1 } END { exit b || !s || !a }' "$T/hs.exr.work/regions.tsv"
 "$PP" render "$SC/radiosity_room.pov" -o "$T/rr1.exr" -W 160 -H 120 --target 1e-6 \
 	--max-passes 1 -v --keep-workdir -- +WT1 2>"$T/rr1.log" || bad "radiosity_room: render failed"
 check "radiosity_room: no antialiased region in the first pass" \
