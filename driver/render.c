@@ -1779,8 +1779,8 @@ static double edge_render_cost(const struct plan_params *pp, const struct plan_r
  * and their render `left`; the rest go back to scale 2, before the
  * antialiased ones (which are folded last: choose_samplers()).  Returns
  * how many keep +R3.  hdr_highlights at 640x480 under --budget 3: its
- * three lamps' renders, of 169 to 289 pixels, at +R3; the four quarters
- * of its floor at scale 2. */
+ * three lamps' renders, of 169 to 289 pixels, and two of the four
+ * quarters of its floor at +R3, the other two at scale 2. */
 static size_t aa_some(const struct run *r, struct plan *pl, const struct plan_params *pp,
 		      double left)
 {
