@@ -151,6 +151,13 @@ for name in ${RENDER_TEST_SCENES:-soft_shadows glossy_reflection thin_geometry};
 	echo "# $name: base $base, final $final (estimated $est) in $cpu CPU s;" \
 		"uniform scale $us ($ucpu CPU s) $urel"
 	check "$name: final relMSE below the base pass's" num 'a < b' "$final" "$base"
+	# each refinement pass's plan predicted a fall from the estimate before
+	# it (planned_relmse); the base pass has no plan (null)
+	check "$name: the report's planned_relmse: null for pass 0, below the estimate before each pass" \
+		awk '/"pass": [0-9]/ { n++; match($0, /"est_relmse": [^,]*/); e = substr($0, RSTART + 14, RLENGTH - 14)
+			match($0, /"planned_relmse": [^,]*/); p = substr($0, RSTART + 18, RLENGTH - 18)
+			if (n == 1) { if (p != "null") b = 1 } else if (p == "null" || !(p + 0 < prev + 0)) b = 1
+			prev = e } END { exit b || n < 2 }' "$T/$name.json"
 	# asserted where the loop is clearly ahead; on glossy_reflection it ties
 	# with uniform scale 8 or 9 (measured 1.03 and 0.85 against the 625-sample
 	# reference), and which of them fits the CPU is a matter of timing noise.
