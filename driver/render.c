@@ -1772,8 +1772,27 @@ static double edge_render_cost(const struct plan_params *pp, const struct plan_r
  */
 #define EDGE_MARGIN 2.0
 #define EDGE_R3_MARGIN 1.5
+/* Whether a pass costing `cost` core-seconds, its dearest render `dearest`,
+ * fits the pass's share pp->budget and the wall time `left` with `margin`. */
+static int fits(double margin, double cost, double dearest, const struct plan_params *pp,
+		double left)
+{
+	return margin * cost <= pp->budget && margin * dearest <= left;
+}
+
+/* Region g, an antialiased render in scale 2's place, back to the scale 2
+ * it was planned as. */
+static void back_to_scale2(struct plan_region *g)
+{
+	g->scale = 2;
+	g->frame = 0;
+	g->edges = 0;
+	g->depth = 0;
+}
+
 /* aa_depth() where +R3 over all of a plan's antialiased regions does not
- * fit: the regions whose +R3 costs least more than their scale 2 keep it
+ * fit: the regions whose +R3 costs (c3, by region, from aa_depth(); NULL
+ * when it ran out of memory: none) least more than their scale 2 keep it
  * while EDGE_R3_MARGIN times the pass (those at +R3, the rest at the
  * scale 2 they were planned as, pl's other regions aside) fits pp->budget
  * and their render `left`; the rest go back to scale 2, before the
@@ -1781,71 +1800,57 @@ static double edge_render_cost(const struct plan_params *pp, const struct plan_r
  * how many keep +R3.  hdr_highlights at 640x480 under --budget 3: its
  * three lamps' renders, of 169 to 289 pixels, and two of the four
  * quarters of its floor at +R3, the other two at scale 2. */
-static size_t aa_some(const struct run *r, struct plan *pl, const struct plan_params *pp,
+static size_t aa_some(struct plan *pl, const struct plan_params *pp, const double *c3,
 		      double left)
 {
 	const size_t n = pl->nregions;
-	double *extra = malloc(n * sizeof(*extra)), *c3 = malloc(n * sizeof(*c3));
 	unsigned char *keep = calloc(n, 1);
 	struct plan_region *to = malloc(n * sizeof(*to));
 	size_t kept = 0;
-	if (extra && c3 && keep && to) {
-		double total = 0.0;
+	if (!c3 || !keep || !to) {	/* out of memory: all back at scale 2, in place */
+		for (size_t k = 0; k < n; k++)
+			if (pl->regions[k].depth)
+				back_to_scale2(&pl->regions[k]);
+		free(keep);
+		free(to);
+		return 0;
+	}
+	double total = 0.0;
+	for (size_t k = 0; k < n; k++)
+		if (pl->regions[k].depth)
+			total += pl->regions[k].cost;
+	for (;;) {	/* the least extra first; n is at most 2 max_regions */
+		size_t b = n;
+		for (size_t k = 0; k < n; k++)
+			if (pl->regions[k].depth && !keep[k] &&
+			    (b == n || c3[k] - pl->regions[k].cost < c3[b] - pl->regions[b].cost))
+				b = k;
+		if (b == n)
+			break;
+		const double extra = c3[b] - pl->regions[b].cost;
+		if (!fits(EDGE_R3_MARGIN, total + extra, c3[b], pp, left))
+			break;
+		keep[b] = 1;
+		total += extra;
+	}
+	/* the plan's scaled regions, those back at scale 2, then those kept at
+	 * +R3, each in their order */
+	size_t m = 0;
+	for (int part = 0; part < 3; part++)
 		for (size_t k = 0; k < n; k++) {
 			const struct plan_region *g = &pl->regions[k];
-			if (!g->depth)
+			if (part != (!g->depth ? 0 : keep[k] ? 2 : 1))
 				continue;
-			c3[k] = edge_render_cost(pp, g, r->acc.w,
-						 edge_pixels(&r->acc, g, ACC_AA_THRESHOLD), 3);
-			extra[k] = c3[k] - g->cost;
-			total += g->cost;
-		}
-		for (;;) {	/* the least extra first; n is at most 2 max_regions */
-			size_t b = n;
-			for (size_t k = 0; k < n; k++)
-				if (pl->regions[k].depth && !keep[k] &&
-				    (b == n || extra[k] < extra[b]))
-					b = k;
-			if (b == n || !(EDGE_R3_MARGIN * (total + extra[b]) <= pp->budget &&
-					EDGE_R3_MARGIN * c3[b] <= left))
-				break;
-			keep[b] = 1;
-			total += extra[b];
-		}
-		/* the plan's scaled regions, those back at scale 2, then those
-		 * kept at +R3, each in their order */
-		size_t m = 0;
-		for (int part = 0; part < 3; part++)
-			for (size_t k = 0; k < n; k++) {
-				const struct plan_region *g = &pl->regions[k];
-				if (part != (!g->depth ? 0 : keep[k] ? 2 : 1))
-					continue;
-				to[m] = *g;
-				if (part == 1) {
-					to[m].scale = 2;
-					to[m].frame = 0;
-					to[m].edges = 0;
-					to[m].depth = 0;
-				} else if (part == 2) {
-					to[m].depth = 3;
-					kept++;
-				}
-				m++;
+			to[m] = *g;
+			if (part == 1) {
+				back_to_scale2(&to[m]);
+			} else if (part == 2) {
+				to[m].depth = 3;
+				kept++;
 			}
-		memcpy(pl->regions, to, n * sizeof(*to));
-	} else {	/* out of memory: all back at scale 2, where they are */
-		for (size_t k = 0; k < n; k++) {
-			struct plan_region *g = &pl->regions[k];
-			if (g->depth) {
-				g->scale = 2;
-				g->frame = 0;
-				g->edges = 0;
-				g->depth = 0;
-			}
+			m++;
 		}
-	}
-	free(extra);
-	free(c3);
+	memcpy(pl->regions, to, n * sizeof(*to));
 	free(keep);
 	free(to);
 	return kept;
@@ -1859,8 +1864,10 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
 		d = pl->regions[k].depth > d ? pl->regions[k].depth : d;
 	if (r->budget > 0.0 && d >= 3) {
 		/* the pass's cost and its dearest render at each depth from 3
-		 * to d, each region's edges counted once */
+		 * to d, each region's edges counted once; each region's cost at
+		 * +R3 for aa_some() */
 		double sum[ACC_AA_DEPTH + 1] = { 0.0 }, worst[ACC_AA_DEPTH + 1] = { 0.0 };
+		double *c3 = malloc(pl->nregions * sizeof(*c3));
 		for (size_t k = 0; k < pl->nregions; k++) {
 			if (!pl->regions[k].depth)
 				continue;
@@ -1869,14 +1876,19 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
 				double c = edge_render_cost(pp, &pl->regions[k], r->acc.w, e, t);
 				sum[t] += c;
 				worst[t] = c > worst[t] ? c : worst[t];
+				if (t == 3 && c3)
+					c3[k] = c;
 			}
 		}
-		while (d > 3 && !(EDGE_MARGIN * sum[d] <= pp->budget && EDGE_MARGIN * worst[d] <= left))
+		while (d > 3 && !fits(EDGE_MARGIN, sum[d], worst[d], pp, left))
 			d--;
-		if (!(EDGE_R3_MARGIN * sum[3] <= pp->budget && EDGE_R3_MARGIN * worst[3] <= left)) {
+		if (!fits(EDGE_R3_MARGIN, sum[3], worst[3], pp, left)) {
 			*price = sum[3];
-			return aa_some(r, pl, pp, left);
+			const size_t kept = aa_some(pl, pp, c3, left);
+			free(c3);
+			return kept;
 		}
+		free(c3);
 	}
 	size_t n = 0;
 	for (size_t k = 0; k < pl->nregions; k++)
@@ -1965,8 +1977,7 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 	}
 	int d = ACC_AA_SPREAD_DEPTH;
 	if (r->budget > 0.0) {
-		while (d >= SPREAD_MIN_DEPTH &&
-		       !(SPREAD_MARGIN * sum[d] <= pp->budget && SPREAD_MARGIN * worst[d] <= left))
+		while (d >= SPREAD_MIN_DEPTH && !fits(SPREAD_MARGIN, sum[d], worst[d], pp, left))
 			d--;
 		if (d < ACC_AA_SPREAD_DEPTH && !(sum[d] >= SPREAD_R2_SHARE * pp->budget))
 			d = 0;	/* see SPREAD_R2_SHARE */
