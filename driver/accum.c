@@ -258,8 +258,10 @@ static double edge_cells(double range, double cells)
  * many cells (see ACC_AA_SPREAD_RANGE): range / ACC_AA_SPREAD_RANGE at
  * ACC_AA_SPREAD_DEPTH's cells, in proportion to them at another depth,
  * at least 1. */
-static double spread_division(double range, double cells)
+static double spread_division(double range, double cells, int edges)
 {
+	if (edges == ACC_AA_FOR_SPREAD_R3 && range < ACC_AA_SPREAD_R3_THRESHOLD)
+		return 1.0;
 	const double k = range / ACC_AA_SPREAD_RANGE * cells /
 			 (double)accum_edge_cells(ACC_AA_SPREAD_DEPTH);
 	return k > 1.0 ? k : 1.0;
@@ -272,7 +274,8 @@ static double spread_division(double range, double cells)
 static long merge_aa(struct image *acc, const struct image *img, int oy, const int ch[3],
 		     int f, int x0, int y0, int x1, int y1, int pass, int depth, int edges)
 {
-	int cells = accum_edge_cells(accum_aa_depth(depth));
+	int cells = edges == ACC_AA_FOR_SPREAD_R3 ? ACC_AA_SPREAD_R3_CELLS
+						   : accum_edge_cells(accum_aa_depth(depth));
 	if (!edges && cells > ACC_AA_FEW)
 		cells = ACC_AA_FEW;	/* see ACC_AA_FEW */
 	int n = aa_worth(acc, img, oy, ch, f, x0, y0, x1, y1);
@@ -316,8 +319,8 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			 * them */
 			const double ec = first ? edge_cells(range, cells) : 1.0;
 			const double ek = !edge ? 1.0
-				: edges != ACC_AA_FOR_SPREAD ? ec
-				: spread_division(range, cells);
+				: !accum_for_spread(edges) ? ec
+				: spread_division(range, cells, edges);
 			int k = first ? (ec > ACC_AA_FIRST ? (int)lround(ec) : ACC_AA_FIRST)
 				      : own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
 			/* taken for edges, the cells vary as the render pixels
@@ -350,7 +353,7 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 					add |= 1u << ACC_AA_NOGRID;
 				if (edge)
 					add |= 1u << ACC_AA_EDGE;
-				if (edges == ACC_AA_FOR_SPREAD)
+				if (accum_for_spread(edges))
 					add |= 1u << ACC_AA_SPREAD_BIT;
 				if ((edge || first) && range >= ACC_AA_THRESHOLD)
 					add |= 1u << ACC_AA_DEEP;

@@ -209,9 +209,33 @@ _Static_assert(ACC_AA_FEW == 1 << (2 * 4), "ACC_AA_FEW is the cells at +R4");
  * (160x120, forced) it did not pay: 5.5e-4 in 8.7 s against 1.3e-4 in
  * 10.3 s, so it is for cheap samples only.
  */
-enum { ACC_AA_FOR_FEW = 0, ACC_AA_FOR_EDGES = 1, ACC_AA_FOR_SPREAD = 2 };
+enum { ACC_AA_FOR_FEW = 0, ACC_AA_FOR_EDGES = 1, ACC_AA_FOR_SPREAD = 2, ACC_AA_FOR_SPREAD_R3 = 3 };
 #define ACC_AA_SPREAD_DEPTH 3
 #define ACC_AA_SPREAD_THRESHOLD 0.03
+/*
+ * The lighter render for spread error (ACC_AA_FOR_SPREAD_R3), for a budget
+ * that +A0.03 +R4 does not fit: +AM1 +A0.1 +R3 +J at twice the size, whose
+ * subdivided pixel has 2 x 2 render pixels of 3 x 3 samples (its depth
+ * column is ignored).  POV-Ray alone at 1280x960, box-averaged to 640x480
+ * (one run each, 2026-12-05 01:30 UTC, CPU s and relMSE against the
+ * sweep's references at scale 9), it erred less than +A0.03 +R2, the
+ * render's other step down, on every scene tried but soft_shadows, where
+ * the two tie: thin_geometry 3.0e-4 in 1.89 s against 7.1e-4 in 1.34 s,
+ * hdr_highlights 1.2e-4 in 3.43 against 3.0e-4 in 4.04, Debian's
+ * noise_generator 2.2e-5 in 2.67 against 6.7e-5 in 2.38, swirlbox 1.4e-4 in
+ * 2.94 against 3.4e-4 in 2.44, var_refl 2.1e-4 in 5.36 against 5.4e-4 in
+ * 3.60, soft_shadows 1.4e-4 in 2.51 against 1.5e-4 in 2.08 (+A0.03 +R4:
+ * 4.3e-5 in 4.87).  Its threshold is the hidden-edge term's
+ * (ACC_AA_THRESHOLD).
+ */
+#define ACC_AA_SPREAD_R3_THRESHOLD 0.1
+#define ACC_AA_SPREAD_R3_CELLS 36
+
+/* Whether a render in scale 2's place was taken for spread error (+AM1). */
+static inline int accum_for_spread(int edges)
+{
+	return edges == ACC_AA_FOR_SPREAD || edges == ACC_AA_FOR_SPREAD_R3;
+}
 /*
  * Such a render's pixel is charged its render pixels' spread (their mean's
  * variance) divided by its range (the colour distance of its render

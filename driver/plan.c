@@ -1201,6 +1201,10 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 			extra[job->nextra++] = "+AM1";
 			extra[job->nextra++] = "+A0.03";	/* ACC_AA_SPREAD_THRESHOLD */
 			extra[job->nextra++] = side[di];
+		} else if (r->frame > 0 && r->edges == ACC_AA_FOR_SPREAD_R3) {
+			extra[job->nextra++] = "+AM1";
+			extra[job->nextra++] = "+A0.1";	/* ACC_AA_SPREAD_R3_THRESHOLD */
+			extra[job->nextra++] = "+R3";
 		} else {
 			extra[job->nextra++] = "+AM2";
 			extra[job->nextra++] = r->frame > 0 ? "+A0.1" : "+A0.0";
@@ -1228,7 +1232,8 @@ int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *ou
 {
 	fprintf(f, "%s (pixels 0-based, inclusive; depth and edges: an antialiased render "
 		"in scale 2's place, its +R, and 1 if taken for edges, 2 for spread error (+AM1), "
-		"0 for a few pixels; else 0 0)\n", REGIONS_HEADER);
+		"3 for spread error at +A0.1 +R3 (+AM1), 0 for a few pixels; else 0 0)\n",
+		REGIONS_HEADER);
 	for (size_t k = 0; k < pl->nregions; k++)
 		if (strchr(outputs[k], '\n'))
 			return -1;	/* the format is one region per line */
@@ -1292,7 +1297,7 @@ static int regions_tail(char *s, struct plan_region *r)
 	if (*end || errno || d > ACC_AA_DEPTH)
 		return -1;
 	long e = strtol(t2 + 1, &end, 10);
-	if (*end || errno || e < ACC_AA_FOR_FEW || e > ACC_AA_FOR_SPREAD)
+	if (*end || errno || e < ACC_AA_FOR_FEW || e > ACC_AA_FOR_SPREAD_R3)
 		return -1;
 	if ((d || e) && (r->scale != ACC_AA || !d))
 		return -1;	/* only an antialiased render has them */
@@ -1338,7 +1343,7 @@ int plan_regions_read(const char *path, struct plan_region **regions, char ***ou
 			if (tail)
 				errbuf_printf(err, errlen, "'%s' line %d: expected \"pass x0 y0 x1 y1 "
 					      "scale output depth edges\" separated by tabs (depth 0 "
-					      "to %d, edges 0, 1 or 2; 0 0 unless the scale is 0)", path,
+					      "to %d, edges 0 to 3; 0 0 unless the scale is 0)", path,
 					      lineno, ACC_AA_DEPTH);
 			else
 				errbuf_printf(err, errlen, "'%s' line %d: expected \"pass x0 y0 x1 y1 "

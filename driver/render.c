@@ -1916,9 +1916,9 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
  * at each pixel whose colour distance to a neighbour reaches the
  * threshold (soft_shadows at 640x480: 5.1 CPU s for 281,600 pixels, 85,840
  * of them such, at 0.87 microseconds a sample, 55 a pixel at +R4); the pass is
- * planned as scale 2, so under a budget the renders are taken at +R4 or
- * else +R2 (SPREAD_MIN_DEPTH; 16 samples a subdivided pixel) only where
- * SPREAD_MARGIN times that cost fits what the pass may spend, priced at
+ * planned as scale 2, so under a budget the renders are taken at the
+ * first of spread_levels (+R4, +A0.1 +R3 or +R2) where SPREAD_MARGIN
+ * times that cost fits what the pass may spend, priced at
  * the base pass's measured cost of a sample, not the plan's power of two
  * (soft_shadows' 0.87 microseconds went at times to 0.48, the +R2 renders
  * took twice their price, and three of seven were lost at the deadline of
@@ -1929,72 +1929,98 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
  * CPU at +R4 and 10 to 16% under at +R2 (soft_shadows and thin_geometry
  * at 640x480); so priced, 24 runs under --budget 2 and 3 lost none of
  * these renders (2026-12-04 21:55 UTC).  Returns how many regions it
- * changed.
+ * changed, and in sums each level's price for the pass (0 where it did
+ * not look).
  */
 #define SPREAD_SAMPLE_S 1.5e-6
-#define SPREAD_MIN_DEPTH 2
 #define SPREAD_MARGIN 1.25
 /*
- * At +R2 the render is taken only where the pass so spends at least this
- * share of what it may.  Where it would spend less, passes follow it, and
+ * The renders a pass's scale-2 regions may become, in the order tried:
+ * +A0.03 +R4 (ACC_AA_SPREAD_DEPTH), then under a budget that it does not
+ * fit the lighter +A0.1 +R3 (ACC_AA_FOR_SPREAD_R3, accum.h) and +A0.03
+ * +R2; each with the colour distance that has POV-Ray subdivide a render
+ * pixel and the samples of a subdivided pixel.
+ */
+static const struct spread_level {
+	int edges, depth;
+	double threshold;
+	int cells;
+} spread_levels[] = {
+	{ ACC_AA_FOR_SPREAD, ACC_AA_SPREAD_DEPTH, ACC_AA_SPREAD_THRESHOLD, 1 << (2 * 3) },
+	{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_DEPTH, ACC_AA_SPREAD_R3_THRESHOLD,
+	  ACC_AA_SPREAD_R3_CELLS },
+	{ ACC_AA_FOR_SPREAD, 2, ACC_AA_SPREAD_THRESHOLD, 1 << (2 * 2) },
+};
+enum { NSPREAD = sizeof spread_levels / sizeof spread_levels[0] };
+_Static_assert(ACC_AA_SPREAD_DEPTH == 3, "spread_levels' first cells are +R4's");
+/*
+ * Below the first level a render is taken only where the pass so spends at
+ * least this share of what it may.  Where it would spend less, passes follow it, and
  * scale 2's smaller step lets them spread the budget over more pixels:
  * under --budget 6 at 640x480, Debian's textures/noise_generator,
  * textures/patterns/granite, textures/finishes/var_refl and advanced/
- * swirlbox took it at shares of 0.30 to 0.48 and erred 1.04 to 1.66 times
+ * swirlbox took +R2 at shares of 0.30 to 0.48 and erred 1.04 to 1.66 times
  * as much as with scale 2 (one run each, 2026-12-04 22:25 UTC), where
  * soft_shadows and swirlbox under 3 s and thin_geometry under 2 s, at 0.52
  * to 0.78, erred 0.23 to 0.57 times as much.
  */
 #define SPREAD_R2_SHARE 0.4
 static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan_params *pp,
-			 double left, int *sparse)
+			 double left, int *sparse, double sums[NSPREAD])
 {
+	for (int t = 0; t < NSPREAD; t++)
+		sums[t] = 0.0;
 	if (run_grid(r) != PLAN_GRID_LARGE || r->aa || r->npasses != 1 || r->radiosity ||
 	    r->focal || !(r->cost_sample <= SPREAD_SAMPLE_S) || !has_scale2(pl) ||
 	    sparse_error(r, sparse))
 		return 0;
-	/* each scale-2 region's price at each depth, the pass's and its
+	/* each scale-2 region's price at each level, the pass's and its
 	 * dearest render's */
-	double *price = calloc(pl->nregions * (ACC_AA_SPREAD_DEPTH + 1), sizeof(*price));
+	double *price = calloc(pl->nregions * NSPREAD, sizeof(*price));
 	if (!price)
 		return 0;
-	double sum[ACC_AA_SPREAD_DEPTH + 1] = { 0.0 }, worst[ACC_AA_SPREAD_DEPTH + 1] = { 0.0 };
+	double sum[NSPREAD] = { 0.0 }, worst[NSPREAD] = { 0.0 };
 	for (size_t k = 0; k < pl->nregions; k++) {
 		const struct plan_region *g = &pl->regions[k];
 		if (g->scale != 2) {	/* the pass's other renders, as planned */
-			for (int t = SPREAD_MIN_DEPTH; t <= ACC_AA_SPREAD_DEPTH; t++)
+			for (int t = 0; t < NSPREAD; t++)
 				sum[t] += g->cost;
 			continue;
 		}
-		const long e = edge_pixels(&r->acc, g, ACC_AA_SPREAD_THRESHOLD);
-		for (int t = SPREAD_MIN_DEPTH; t <= ACC_AA_SPREAD_DEPTH; t++) {
+		long e = -1;
+		for (int t = 0; t < NSPREAD; t++) {
+			const struct spread_level *lv = &spread_levels[t];
+			if (t == 0 || lv->threshold != spread_levels[t - 1].threshold)
+				e = edge_pixels(&r->acc, g, lv->threshold);
 			const double c = aa_render_cost(pp, g, r->acc.w, r->cost_sample_measured, e,
-							accum_edge_cells(t));
-			price[k * (ACC_AA_SPREAD_DEPTH + 1) + t] = c;
+							lv->cells);
+			price[k * NSPREAD + t] = c;
 			sum[t] += c;
 			worst[t] = c > worst[t] ? c : worst[t];
 		}
 	}
-	int d = ACC_AA_SPREAD_DEPTH;
+	for (int t = 0; t < NSPREAD; t++)
+		sums[t] = sum[t];
+	int t = 0;
 	if (r->budget > 0.0) {
-		while (d >= SPREAD_MIN_DEPTH && !fits(SPREAD_MARGIN, sum[d], worst[d], pp, left))
-			d--;
-		if (d < ACC_AA_SPREAD_DEPTH && !(sum[d] >= SPREAD_R2_SHARE * pp->budget))
-			d = 0;	/* see SPREAD_R2_SHARE */
+		while (t < NSPREAD && !fits(SPREAD_MARGIN, sum[t], worst[t], pp, left))
+			t++;
+		if (t > 0 && t < NSPREAD && !(sum[t] >= SPREAD_R2_SHARE * pp->budget))
+			t = NSPREAD;	/* see SPREAD_R2_SHARE */
 	}
 	size_t n = 0;
-	for (size_t k = 0; k < pl->nregions && d >= SPREAD_MIN_DEPTH; k++) {
+	for (size_t k = 0; k < pl->nregions && t < NSPREAD; k++) {
 		struct plan_region *g = &pl->regions[k];
 		if (g->scale != 2)
 			continue;
 		g->scale = ACC_AA;
 		g->frame = ACC_GRID_FRAME;
-		g->edges = ACC_AA_FOR_SPREAD;
-		g->depth = d;
+		g->edges = spread_levels[t].edges;
+		g->depth = spread_levels[t].depth;
 		/* its price, for the progress display's guess and the
 		 * renders' timeout */
-		pl->cost += price[k * (ACC_AA_SPREAD_DEPTH + 1) + d] - g->cost;
-		g->cost = price[k * (ACC_AA_SPREAD_DEPTH + 1) + d];
+		pl->cost += price[k * NSPREAD + t] - g->cost;
+		g->cost = price[k * NSPREAD + t];
 		n++;
 	}
 	free(price);
@@ -2283,8 +2309,15 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 				progress(r, "pass %d: antialiasing in all %zu regions would not "
 					 "fit the budget even at +R3 (about %.1f core-s): %zu at "
 					 "+R3, the rest at scale 2", pass, all, price, naa);
-		} else
-			naa = spread_am1(r, &pl, &pp, left, &sparse);
+		} else {
+			double sums[NSPREAD];
+			naa = spread_am1(r, &pl, &pp, left, &sparse, sums);
+			if (r->verbose && r->budget > 0.0 && sums[0] > 0.0)
+				progress(r, "pass %d: the error is spread: POV-Ray's +AM1 over the "
+					 "scale-2 regions about %.1f core-s at +A0.03 +R4, %.1f at "
+					 "+A0.1 +R3, %.1f at +A0.03 +R2; the pass may spend %.1f",
+					 pass, sums[0], sums[1], sums[2], pp.budget);
+		}
 		if (!early || prelaunch_cover(r, pass, &pl, &pre_idx))
 			break;
 		/* the early renders do not serve this plan: plan again for
@@ -2355,7 +2388,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			 * edges everywhere, took 21 CPU s a render planned at
 			 * 0.3 s, inside the timeout only by the image's size) */
 			const double gc =
-				g->scale == ACC_AA && g->frame > 0 && g->edges != ACC_AA_FOR_SPREAD
+				g->scale == ACC_AA && g->frame > 0 && !accum_for_spread(g->edges)
 					? edge_render_cost(&pp, g, r->acc.w,
 							   edge_pixels(&r->acc, g, ACC_AA_THRESHOLD),
 							   accum_aa_depth(g->depth))
@@ -2396,10 +2429,11 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	}
 	if (naa)
 		progress(r, "pass %d: the estimated error %s: %zu region%s by POV-Ray's "
-			 "antialiasing (+AM%d) in place of scale 2, depth %d", pass,
-			 edges == ACC_AA_FOR_SPREAD ? "is spread and samples are cheap"
+			 "antialiasing (+AM%d) in place of scale 2, %s %d", pass,
+			 accum_for_spread(edges) ? "is spread and samples are cheap"
 			 : edges ? "sits at edges" : "sits in few pixels",
-			 naa, naa == 1 ? "" : "s", edges == ACC_AA_FOR_SPREAD ? 1 : 2, depth);
+			 naa, naa == 1 ? "" : "s", accum_for_spread(edges) ? 1 : 2,
+			 edges == ACC_AA_FOR_SPREAD_R3 ? "+A0.1 +R3" : "depth", depth);
 	progress(r, "pass %d: %zu region%s, %ld pixels (%ld chosen), %.0f samples, about %.1f s",
 		 pass, n, n == 1 ? "" : "s", pl.pixels, pl.chosen_pixels, pl.samples,
 		 guess + r->latency);

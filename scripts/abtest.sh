@@ -24,7 +24,11 @@
 # Prints a line per run and, per scene and setting, the geometric means of
 # both builds' relMSE and CPU and their ratio B/A; at the end the geometric
 # mean of those ratios over all rows.  Every run goes to $OUT (default
-# build/abtest/runs.csv): scene,setting,build,run,cpu_s,wall_s,relmse,est.
+# build/abtest/runs.csv): scene,setting,build,run,cpu_s,wall_s,relmse,est,
+# total_cpu_s.  cpu_s is the report's all_cpu_s (the POV-Ray children and
+# povpress while they ran and merged, not its analyses); total_cpu_s adds
+# all of povpress's own CPU (cpu_s + own_cpu_s of the report's totals), as
+# make sweep counts a run, for ratios to POV-Ray's envelope.
 set -euo pipefail
 
 usage() {
@@ -106,7 +110,7 @@ mkdir -p "$OUT"
 T=$(mktemp -d "${TMPDIR:-/tmp}/povpress-abtest.XXXXXX")
 trap 'rm -rf "$T"' EXIT
 csv=$OUT/runs.csv
-echo "scene,setting,build,run,cpu_s,wall_s,relmse,est" >"$csv.tmp"
+echo "scene,setting,build,run,cpu_s,wall_s,relmse,est,total_cpu_s" >"$csv.tmp"
 
 field() { # REPORT KEY: the last number under KEY in a JSON report
 	grep -o "\"$2\": [-0-9.e+]*" "$1" | tail -n 1 | awk '{ print $2 }'
@@ -128,9 +132,11 @@ for sc in "${scenes[@]}"; do
 				cpu=$(field "$d.json" all_cpu_s)
 				wall=$(field "$d.json" wall_s)
 				est=$(field "$d.json" est_relmse)
+				tot=$(awk -v a="$(field "$d.json" cpu_s)" -v b="$(field "$d.json" own_cpu_s)" \
+					'BEGIN { printf "%.3f", a + b }')
 				printf '%-18s %-12s %-2s %4d %8.3f %8.3f %10.3g %10.3g\n' \
 					"$sc" "$set" $ab $k "$cpu" "$wall" "$rel" "$est"
-				echo "$sc,$set,$ab,$k,$cpu,$wall,$rel,$est" >>"$csv.tmp"
+				echo "$sc,$set,$ab,$k,$cpu,$wall,$rel,$est,$tot" >>"$csv.tmp"
 			done
 		done
 	done

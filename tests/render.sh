@@ -625,6 +625,50 @@ if ref=$(W=320 H=240 reference "$scene"); then
 	check "... its estimate within 4 times the true relMSE" num 'a <= 4 * b && 4 * a >= b' "$est" "$au"
 	check "--sampler scale: no antialiased region" \
 		test -z "$(compgen -G "$T/am1-scale.exr.work/p*-aa.exr")"
+	# under a budget that +A0.03 +R4 does not fit but the lighter +A0.1 +R3
+	# does (ACC_AA_FOR_SPREAD_R3), that one.  The pass may spend (budget -
+	# elapsed - latency - 0.2) x cores x 0.8 core-s: a run under 30 s prints
+	# the prices and what it may spend, and the budget is moved so that
+	# the pass may spend the geometric middle of 1.25 times the two prices
+	# (one core, so the core-seconds move as 0.8 times the budget)
+	sp=(taskset -c 0 "$PP" render "$scene" -W 320 -H 240 --target 1e-6 --max-passes 1
+		--cost-sample 1e-6 --cost-job 0.05 -v --keep-workdir)
+	"${sp[@]}" -o "$T/r3a.exr" --budget 30 -- +WT1 2>"$T/r3a.log" ||
+		bad "thin_geometry 320x240 --budget 30: render failed"
+	read -r p4 p3 may < <(sed -n 's/.*about \([0-9.]*\) core-s at +A0.03 +R4, \([0-9.]*\) at +A0.1 +R3.*may spend \([0-9.]*\)$/\1 \2 \3/p' "$T/r3a.log")
+	check "under 30 s: the pass's prices at +R4 ($p4) and +A0.1 +R3 ($p3), +R4 the dearer" \
+		num 'a > b && b > 0' "${p4:-0}" "${p3:-0}"
+	check "... +R4 taken" grep -q "(+AM1) in place of scale 2, depth 3" "$T/r3a.log"
+	b=$(awk -v p4="${p4:-1}" -v p3="${p3:-1}" -v m="${may:-1}" \
+		'BEGIN { printf "%.2f", 30 - (m - 1.25 * sqrt(p3 * p4)) / 0.8 }')
+	"${sp[@]}" -o "$T/r3.exr" --budget "$b" --report "$T/r3.json" -- +WT1 2>"$T/r3.log" ||
+		bad "thin_geometry 320x240 --budget $b: render failed"
+	read -r q4 q3 m2 < <(sed -n 's/.*about \([0-9.]*\) core-s at +A0.03 +R4, \([0-9.]*\) at +A0.1 +R3.*may spend \([0-9.]*\)$/\1 \2 \3/p' "$T/r3.log")
+	check "under $b s the pass may spend $m2, between 1.25 times +A0.1 +R3's $q3 and +R4's $q4" \
+		num 'a >= 1.25 * b && a < 1.25 * c' "${m2:-0}" "${q3:-1}" "${q4:-0}"
+	check "... so +A0.1 +R3 in scale 2's place" \
+		grep -q "(+AM1) in place of scale 2, +A0.1 +R3" "$T/r3.log"
+	check "... its regions file says so (scale 0, edges 3)" \
+		awk -F'\t' '$1 == 1 && $6 == 0 && $9 == 3 { f = 1 } END { exit !f }' \
+		"$T/r3.exr.work/regions.tsv"
+	check "... no region at +R4 or scale 2" \
+		awk -F'\t' '$1 == 1 && ($9 == 2 || $6 == 2) { f = 1 } END { exit f }' \
+		"$T/r3.exr.work/regions.tsv"
+	a1=$(compgen -G "$T/r3.exr.work/p01-*-aa.exr" | head -n 1)
+	check "... at twice the image's size" grep -q "640 x *480" <(iinfo "$a1" 2>&1)
+	check "... its pixels marked (scales bit 9)" \
+		num 'a >= 512 && a < 1024' "$(oiiotool "$T/r3.errors.exr" --ch scales \
+			--printstats 2>/dev/null | awk '/Max:/ { print $3; exit }')"
+	check "... within the budget" num 'a <= b' \
+		"$(grep -o '"wall_s": [0-9.]*' "$T/r3.json" | tail -n 1 | awk '{ print $2 }')" "$b"
+	r3=$(relmse "$T/r3.exr" "$ref")
+	r4=$(relmse "$T/r3a.exr" "$ref")
+	est=$("$PP" compare "$T/r3.exr" "$ref" --analysis "$T/r3.errors.exr" |
+		awk '$1 == "est_relmse:" { print $2 }')
+	echo "# thin_geometry 320x240, one pass, one core: relMSE $r3 at +A0.1 +R3 (estimated $est), $r4 at +R4, $sc with scale 2"
+	check "... relMSE at most half of scale 2's" num 'a <= 0.5 * b' "$r3" "$sc"
+	check "... and above +R4's" num 'a > b' "$r3" "$r4"
+	check "... its estimate within 4 times the true relMSE" num 'a <= 4 * b && 4 * a >= b' "$est" "$r3"
 else
 	bad "thin_geometry 320x240: reference render failed"
 fi
