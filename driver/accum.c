@@ -260,7 +260,7 @@ static double edge_cells(double range, double cells)
  * at least 1. */
 static double spread_division(double range, double cells, int edges)
 {
-	if (edges == ACC_AA_FOR_SPREAD_R3 && range < ACC_AA_SPREAD_R3_THRESHOLD)
+	if (range < accum_spread_light_threshold(edges))
 		return 1.0;
 	const double k = range / ACC_AA_SPREAD_RANGE * cells /
 			 (double)accum_edge_cells(ACC_AA_SPREAD_DEPTH);
@@ -274,8 +274,9 @@ static double spread_division(double range, double cells, int edges)
 static long merge_aa(struct image *acc, const struct image *img, int oy, const int ch[3],
 		     int f, int x0, int y0, int x1, int y1, int pass, int depth, int edges)
 {
-	int cells = edges == ACC_AA_FOR_SPREAD_R3 ? ACC_AA_SPREAD_R3_CELLS
-						   : accum_edge_cells(accum_aa_depth(depth));
+	int cells = edges == ACC_AA_FOR_SPREAD_R3	? ACC_AA_SPREAD_R3_CELLS
+		    : edges == ACC_AA_FOR_SPREAD_FLOOR ? ACC_AA_SPREAD_FLOOR_CELLS
+						       : accum_edge_cells(accum_aa_depth(depth));
 	if (!edges && cells > ACC_AA_FEW)
 		cells = ACC_AA_FEW;	/* see ACC_AA_FEW */
 	int n = aa_worth(acc, img, oy, ch, f, x0, y0, x1, y1);

@@ -1205,6 +1205,10 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 			extra[job->nextra++] = "+AM1";
 			extra[job->nextra++] = "+A0.1";	/* ACC_AA_SPREAD_R3_THRESHOLD */
 			extra[job->nextra++] = "+R3";
+		} else if (r->frame > 0 && r->edges == ACC_AA_FOR_SPREAD_FLOOR) {
+			extra[job->nextra++] = "+AM1";
+			extra[job->nextra++] = "+A0.3";	/* ACC_AA_SPREAD_FLOOR_THRESHOLD */
+			extra[job->nextra++] = "+R2";
 		} else {
 			extra[job->nextra++] = "+AM2";
 			extra[job->nextra++] = r->frame > 0 ? "+A0.1" : "+A0.0";
@@ -1232,7 +1236,7 @@ int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *ou
 {
 	fprintf(f, "%s (pixels 0-based, inclusive; depth and edges: an antialiased render "
 		"in scale 2's place, its +R, and 1 if taken for edges, 2 for spread error (+AM1), "
-		"3 for spread error at +A0.1 +R3 (+AM1), 0 for a few pixels; else 0 0)\n",
+		"3 at +A0.1 +R3 and 4 at +A0.3 +R2, 0 for a few pixels; else 0 0)\n",
 		REGIONS_HEADER);
 	for (size_t k = 0; k < pl->nregions; k++)
 		if (strchr(outputs[k], '\n'))
@@ -1297,7 +1301,7 @@ static int regions_tail(char *s, struct plan_region *r)
 	if (*end || errno || d > ACC_AA_DEPTH)
 		return -1;
 	long e = strtol(t2 + 1, &end, 10);
-	if (*end || errno || e < ACC_AA_FOR_FEW || e > ACC_AA_FOR_SPREAD_R3)
+	if (*end || errno || e < ACC_AA_FOR_FEW || e > ACC_AA_FOR_SPREAD_FLOOR)
 		return -1;
 	if ((d || e) && (r->scale != ACC_AA || !d))
 		return -1;	/* only an antialiased render has them */
@@ -1343,7 +1347,7 @@ int plan_regions_read(const char *path, struct plan_region **regions, char ***ou
 			if (tail)
 				errbuf_printf(err, errlen, "'%s' line %d: expected \"pass x0 y0 x1 y1 "
 					      "scale output depth edges\" separated by tabs (depth 0 "
-					      "to %d, edges 0 to 3; 0 0 unless the scale is 0)", path,
+					      "to %d, edges 0 to 4; 0 0 unless the scale is 0)", path,
 					      lineno, ACC_AA_DEPTH);
 			else
 				errbuf_printf(err, errlen, "'%s' line %d: expected \"pass x0 y0 x1 y1 "

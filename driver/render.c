@@ -1937,19 +1937,24 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
 /*
  * The renders a pass's scale-2 regions may become, in the order tried:
  * +A0.03 +R4 (ACC_AA_SPREAD_DEPTH), then under a budget that it does not
- * fit the lighter +A0.1 +R3 (ACC_AA_FOR_SPREAD_R3, accum.h) and +A0.03
- * +R2; each with the colour distance that has POV-Ray subdivide a render
- * pixel and the samples of a subdivided pixel.
+ * fit the lighter +A0.1 +R3 (ACC_AA_FOR_SPREAD_R3, accum.h), +A0.03 +R2
+ * and +A0.3 +R2 (ACC_AA_FOR_SPREAD_FLOOR); each with the colour distance
+ * that has POV-Ray subdivide a render pixel, the samples of a subdivided
+ * pixel and its name for the progress display.
  */
 static const struct spread_level {
 	int edges, depth;
 	double threshold;
 	int cells;
+	const char *name;
 } spread_levels[] = {
-	{ ACC_AA_FOR_SPREAD, ACC_AA_SPREAD_DEPTH, ACC_AA_SPREAD_THRESHOLD, 1 << (2 * 3) },
+	{ ACC_AA_FOR_SPREAD, ACC_AA_SPREAD_DEPTH, ACC_AA_SPREAD_THRESHOLD, 1 << (2 * 3),
+	  "+A0.03 +R4" },
 	{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_DEPTH, ACC_AA_SPREAD_R3_THRESHOLD,
-	  ACC_AA_SPREAD_R3_CELLS },
-	{ ACC_AA_FOR_SPREAD, 2, ACC_AA_SPREAD_THRESHOLD, 1 << (2 * 2) },
+	  ACC_AA_SPREAD_R3_CELLS, "+A0.1 +R3" },
+	{ ACC_AA_FOR_SPREAD, 2, ACC_AA_SPREAD_THRESHOLD, 1 << (2 * 2), "+A0.03 +R2" },
+	{ ACC_AA_FOR_SPREAD_FLOOR, 2, ACC_AA_SPREAD_FLOOR_THRESHOLD, ACC_AA_SPREAD_FLOOR_CELLS,
+	  "+A0.3 +R2" },
 };
 enum { NSPREAD = sizeof spread_levels / sizeof spread_levels[0] };
 _Static_assert(ACC_AA_SPREAD_DEPTH == 3, "spread_levels' first cells are +R4's");
@@ -2312,11 +2317,17 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		} else {
 			double sums[NSPREAD];
 			naa = spread_am1(r, &pl, &pp, left, &sparse, sums);
-			if (r->verbose && r->budget > 0.0 && sums[0] > 0.0)
+			if (r->verbose && r->budget > 0.0 && sums[0] > 0.0) {
+				char what[256];
+				int at = 0;
+				for (int l = 0; l < NSPREAD && at >= 0 && at < (int)sizeof(what); l++)
+					at += snprintf(what + at, sizeof(what) - (size_t)at,
+						       "%s%.1f%s at %s", l ? ", " : "", sums[l],
+						       l ? "" : " core-s", spread_levels[l].name);
 				progress(r, "pass %d: the error is spread: POV-Ray's +AM1 over the "
-					 "scale-2 regions about %.1f core-s at +A0.03 +R4, %.1f at "
-					 "+A0.1 +R3, %.1f at +A0.03 +R2; the pass may spend %.1f",
-					 pass, sums[0], sums[1], sums[2], pp.budget);
+					 "scale-2 regions about %s; the pass may spend %.1f", pass,
+					 what, pp.budget);
+			}
 		}
 		if (!early || prelaunch_cover(r, pass, &pl, &pre_idx))
 			break;
@@ -2427,13 +2438,21 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		depth = pl.regions[k].depth > depth ? pl.regions[k].depth : depth;
 		edges = pl.regions[k].edges > edges ? pl.regions[k].edges : edges;
 	}
-	if (naa)
+	if (naa) {
+		/* the lighter renders for spread error by name, the others
+		 * by depth */
+		char how[32];
+		if (accum_spread_light_threshold(edges) > 0.0)
+			snprintf(how, sizeof(how), "%s",
+				 edges == ACC_AA_FOR_SPREAD_R3 ? "+A0.1 +R3" : "+A0.3 +R2");
+		else
+			snprintf(how, sizeof(how), "depth %d", depth);
 		progress(r, "pass %d: the estimated error %s: %zu region%s by POV-Ray's "
-			 "antialiasing (+AM%d) in place of scale 2, %s %d", pass,
+			 "antialiasing (+AM%d) in place of scale 2, %s", pass,
 			 accum_for_spread(edges) ? "is spread and samples are cheap"
 			 : edges ? "sits at edges" : "sits in few pixels",
-			 naa, naa == 1 ? "" : "s", accum_for_spread(edges) ? 1 : 2,
-			 edges == ACC_AA_FOR_SPREAD_R3 ? "+A0.1 +R3" : "depth", depth);
+			 naa, naa == 1 ? "" : "s", accum_for_spread(edges) ? 1 : 2, how);
+	}
 	progress(r, "pass %d: %zu region%s, %ld pixels (%ld chosen), %.0f samples, about %.1f s",
 		 pass, n, n == 1 ? "" : "s", pl.pixels, pl.chosen_pixels, pl.samples,
 		 guess + r->latency);

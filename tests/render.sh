@@ -586,6 +586,59 @@ check "... resumed with --sampler scale, the run goes by it" \
 	-v --report "$T/tm.json" -- +WT1 2>"$T/tm.log" || bad "soft_shadows, target 0.5: render failed"
 check "... no pass, no choice: the report says auto" grep -q '"sampler_chosen": "auto"' "$T/tm.json"
 check "... and no line says otherwise" test "$(grep -c 'no scale 2' "$T/tm.log")" -eq 0
+# spread_level SCENE TAG LOW HIGH: the first refinement pass of SCENE at
+# 320x240 on one core, the cost of a sample pinned at 1e-6 s (spread error,
+# its scale-2 regions rendered by POV-Ray's +AM1 at twice the size), under
+# a budget that fits the render level LOW (as -v names it) but not the one
+# tried before it, HIGH: a run under 30 s ($T/TAG-30.exr) prints each
+# level's price and what the pass may spend, (budget - elapsed - latency
+# - 0.2) x 0.8 core-s on one core, and the budget is moved so that the pass
+# may spend the geometric middle of 1.25 times the two ($T/TAG.exr, its
+# log TAG.log and report TAG.json; moved once more where it missed).  Checks that the pass so took LOW,
+# rendered at twice the size, marked its pixels and ended within the
+# budget; fails when a run fails.
+spread_level() {
+	local scene=$1 tag=$2 lo=$3 hi=$4 b plo phi may m2 a1 try
+	local sp=(taskset -c 0 "$PP" render "$scene" -W 320 -H 240 --target 1e-6 --max-passes 1
+		--cost-sample 1e-6 --cost-job 0.05 -v --keep-workdir)
+	"${sp[@]}" -o "$T/$tag-30.exr" --budget 30 -- +WT1 2>"$T/$tag-30.log" ||
+		{ bad "$(basename "$scene") 320x240 --budget 30: render failed"; return 1; }
+	# price LOG NAME: the price -v printed for the level NAME
+	price() { grep -o "[0-9.]*\( core-s\)\? at $2[,;]" "$1" | head -n 1 | awk '{ print $1 }'; }
+	spend() { sed -n 's/.*the pass may spend \([0-9.]*\)$/\1/p' "$1" | head -n 1; }
+	plo=$(price "$T/$tag-30.log" "$lo")
+	phi=$(price "$T/$tag-30.log" "$hi")
+	may=$(spend "$T/$tag-30.log")
+	check "$(basename "$scene") under 30 s: the pass's prices at $hi ($phi) and $lo ($plo), $hi the dearer" \
+		num 'a > b && b > 0' "${phi:-0}" "${plo:-0}"
+	b=30
+	# a second try, moved by what the first missed by, where the times
+	# of the base pass and the analysis moved between the runs
+	for try in 1 2; do
+		b=$(awk -v b="$b" -v h="${phi:-1}" -v l="${plo:-1}" -v m="${may:-1}" \
+			'BEGIN { printf "%.2f", b - (m - 1.25 * sqrt(h * l)) / 0.8 }')
+		"${sp[@]}" -o "$T/$tag.exr" --budget "$b" --report "$T/$tag.json" -- +WT1 \
+			2>"$T/$tag.log" ||
+			{ bad "$(basename "$scene") 320x240 --budget $b: render failed"; return 1; }
+		plo=$(price "$T/$tag.log" "$lo")
+		phi=$(price "$T/$tag.log" "$hi")
+		m2=$(spend "$T/$tag.log")
+		may=$m2
+		num 'a >= 1.25 * b && a < 1.25 * c' "${m2:-0}" "${plo:-1}" "${phi:-0}" && break
+	done
+	check "... under $b s the pass may spend $m2, between 1.25 times $lo's $plo and $hi's $phi" \
+		num 'a >= 1.25 * b && a < 1.25 * c' "${m2:-0}" "${plo:-1}" "${phi:-0}"
+	check "... so $lo in scale 2's place" grep -q "(+AM1) in place of scale 2, $lo\$" "$T/$tag.log"
+	check "... no region of scale 2" \
+		awk -F'\t' '$1 == 1 && $6 == 2 { f = 1 } END { exit f }' "$T/$tag.exr.work/regions.tsv"
+	a1=$(compgen -G "$T/$tag.exr.work/p01-*-aa.exr" | head -n 1)
+	check "... at twice the image's size" grep -q "640 x *480" <(iinfo "$a1" 2>&1)
+	check "... its pixels marked (scales bit 9)" \
+		num 'a >= 512 && a < 1024' "$(oiiotool "$T/$tag.errors.exr" --ch scales \
+			--printstats 2>/dev/null | awk '/Max:/ { print $3; exit }')"
+	check "... within the budget" num 'a <= b' "$(jget "$T/$tag.json" wall_s)" "$b"
+}
+
 # spread error where the frame at scale 4 is dearer than 0.7 s on the cores
 # but a sample costs at most 1.5 microseconds (thin_geometry at 320x240 on
 # one core, the cost of a sample pinned at 1e-6 s): the first pass renders
@@ -626,51 +679,42 @@ if ref=$(W=320 H=240 reference "$scene"); then
 	check "--sampler scale: no antialiased region" \
 		test -z "$(compgen -G "$T/am1-scale.exr.work/p*-aa.exr")"
 	# under a budget that +A0.03 +R4 does not fit but the lighter +A0.1 +R3
-	# does (ACC_AA_FOR_SPREAD_R3), that one.  The pass may spend (budget -
-	# elapsed - latency - 0.2) x cores x 0.8 core-s: a run under 30 s prints
-	# the prices and what it may spend, and the budget is moved so that
-	# the pass may spend the geometric middle of 1.25 times the two prices
-	# (one core, so the core-seconds move as 0.8 times the budget)
-	sp=(taskset -c 0 "$PP" render "$scene" -W 320 -H 240 --target 1e-6 --max-passes 1
-		--cost-sample 1e-6 --cost-job 0.05 -v --keep-workdir)
-	"${sp[@]}" -o "$T/r3a.exr" --budget 30 -- +WT1 2>"$T/r3a.log" ||
-		bad "thin_geometry 320x240 --budget 30: render failed"
-	read -r p4 p3 may < <(sed -n 's/.*about \([0-9.]*\) core-s at +A0.03 +R4, \([0-9.]*\) at +A0.1 +R3.*may spend \([0-9.]*\)$/\1 \2 \3/p' "$T/r3a.log")
-	check "under 30 s: the pass's prices at +R4 ($p4) and +A0.1 +R3 ($p3), +R4 the dearer" \
-		num 'a > b && b > 0' "${p4:-0}" "${p3:-0}"
-	check "... +R4 taken" grep -q "(+AM1) in place of scale 2, depth 3" "$T/r3a.log"
-	b=$(awk -v p4="${p4:-1}" -v p3="${p3:-1}" -v m="${may:-1}" \
-		'BEGIN { printf "%.2f", 30 - (m - 1.25 * sqrt(p3 * p4)) / 0.8 }')
-	"${sp[@]}" -o "$T/r3.exr" --budget "$b" --report "$T/r3.json" -- +WT1 2>"$T/r3.log" ||
-		bad "thin_geometry 320x240 --budget $b: render failed"
-	read -r q4 q3 m2 < <(sed -n 's/.*about \([0-9.]*\) core-s at +A0.03 +R4, \([0-9.]*\) at +A0.1 +R3.*may spend \([0-9.]*\)$/\1 \2 \3/p' "$T/r3.log")
-	check "under $b s the pass may spend $m2, between 1.25 times +A0.1 +R3's $q3 and +R4's $q4" \
-		num 'a >= 1.25 * b && a < 1.25 * c' "${m2:-0}" "${q3:-1}" "${q4:-0}"
-	check "... so +A0.1 +R3 in scale 2's place" \
-		grep -q "(+AM1) in place of scale 2, +A0.1 +R3" "$T/r3.log"
-	check "... its regions file says so (scale 0, edges 3)" \
-		awk -F'\t' '$1 == 1 && $6 == 0 && $9 == 3 { f = 1 } END { exit !f }' \
-		"$T/r3.exr.work/regions.tsv"
-	check "... no region at +R4 or scale 2" \
-		awk -F'\t' '$1 == 1 && ($9 == 2 || $6 == 2) { f = 1 } END { exit f }' \
-		"$T/r3.exr.work/regions.tsv"
-	a1=$(compgen -G "$T/r3.exr.work/p01-*-aa.exr" | head -n 1)
-	check "... at twice the image's size" grep -q "640 x *480" <(iinfo "$a1" 2>&1)
-	check "... its pixels marked (scales bit 9)" \
-		num 'a >= 512 && a < 1024' "$(oiiotool "$T/r3.errors.exr" --ch scales \
-			--printstats 2>/dev/null | awk '/Max:/ { print $3; exit }')"
-	check "... within the budget" num 'a <= b' \
-		"$(grep -o '"wall_s": [0-9.]*' "$T/r3.json" | tail -n 1 | awk '{ print $2 }')" "$b"
-	r3=$(relmse "$T/r3.exr" "$ref")
-	r4=$(relmse "$T/r3a.exr" "$ref")
-	est=$("$PP" compare "$T/r3.exr" "$ref" --analysis "$T/r3.errors.exr" |
-		awk '$1 == "est_relmse:" { print $2 }')
-	echo "# thin_geometry 320x240, one pass, one core: relMSE $r3 at +A0.1 +R3 (estimated $est), $r4 at +R4, $sc with scale 2"
-	check "... relMSE at most half of scale 2's" num 'a <= 0.5 * b' "$r3" "$sc"
-	check "... and above +R4's" num 'a > b' "$r3" "$r4"
-	check "... its estimate within 4 times the true relMSE" num 'a <= 4 * b && 4 * a >= b' "$est" "$r3"
+	# does (ACC_AA_FOR_SPREAD_R3), that one (spread_level, above)
+	if spread_level "$scene" r3 "+A0.1 +R3" "+A0.03 +R4"; then
+		check "... its regions file says so (scale 0, edges 3)" \
+			awk -F'\t' '$1 == 1 && $6 == 0 && $9 == 3 { f = 1 } END { exit !f }' \
+			"$T/r3.exr.work/regions.tsv"
+		r3=$(relmse "$T/r3.exr" "$ref")
+		r4=$(relmse "$T/r3-30.exr" "$ref")
+		est=$("$PP" compare "$T/r3.exr" "$ref" --analysis "$T/r3.errors.exr" |
+			awk '$1 == "est_relmse:" { print $2 }')
+		echo "# thin_geometry 320x240, one pass, one core: relMSE $r3 at +A0.1 +R3 (estimated $est), $r4 at +R4, $sc with scale 2"
+		check "... relMSE at most half of scale 2's" num 'a <= 0.5 * b' "$r3" "$sc"
+		check "... and above +R4's" num 'a > b' "$r3" "$r4"
+		check "... its estimate within 4 times the true relMSE" \
+			num 'a <= 4 * b && 4 * a >= b' "$est" "$r3"
+	fi
 else
 	bad "thin_geometry 320x240: reference render failed"
+fi
+# ... and where neither +A0.1 +R3 nor +A0.03 +R2 fits, the lightest, +A0.3
+# +R2 (ACC_AA_FOR_SPREAD_FLOOR), on a texture: horizon_texture.  Against
+# the run under 30 s (+R4, several times less error than either) it errs
+# less than scale 2 in the same pass under the same budget (measured 2.1e-3
+# against 6.1e-3; on soft_shadows, no texture, the two erred alike).
+scene="$SC/horizon_texture.pov"
+if spread_level "$scene" floor "+A0.3 +R2" "+A0.03 +R2"; then
+	check "... its regions file says so (scale 0, edges 4)" \
+		awk -F'\t' '$1 == 1 && $6 == 0 && $9 == 4 { f = 1 } END { exit !f }' \
+		"$T/floor.exr.work/regions.tsv"
+	b=$(jget "$T/floor.json" budget)
+	taskset -c 0 "$PP" render "$scene" -o "$T/floor-s2.exr" -W 320 -H 240 --target 1e-6 \
+		--max-passes 1 --cost-sample 1e-6 --cost-job 0.05 --sampler scale --budget "$b" \
+		-q -- +WT1 || bad "horizon_texture 320x240 --sampler scale --budget $b: render failed"
+	fl=$(relmse "$T/floor.exr" "$T/floor-30.exr")
+	s2=$(relmse "$T/floor-s2.exr" "$T/floor-30.exr")
+	echo "# horizon_texture 320x240, one pass, one core, against +R4: relMSE $fl at +A0.3 +R2, $s2 at scale 2"
+	check "... relMSE at most 0.6 of scale 2's under the same budget" num 'a <= 0.6 * b' "$fl" "$s2"
 fi
 
 # --- a smooth, nearly empty scene costs almost nothing beyond the base pass --

@@ -1110,47 +1110,68 @@ static void test_merge_aa_edges(void **state)
 				assert_true(p[ACC_DIFF] > o[ACC_DIFF]);
 		}
 		image_release(&spr);
-		/* the lighter render for spread error (+A0.1 +R3, whatever
-		 * the depth): 36 cells a subdivided pixel; a pixel whose render
-		 * pixels differ by less than its threshold was not subdivided,
-		 * and its spread is its error's as it stands */
-		make_acc(&spr, 5, 1, flat_value);
-		assert_int_equal(accum_merge_aa_region(&spr, &big, 0, ACC_AA, depth,
-							 ACC_AA_FOR_SPREAD_R3, 0, 0, 4, 0, 1,
-							 &folded, err, sizeof(err)), 0);
-		assert_int_equal(folded, 5);
-		for (int x = 0; x < 5; x++) {
-			const float *p = accpx(&spr, (size_t)x);
-			const double range = 3.0 * spread[x];
-			const double ek = edge_cells_want(range, ACC_AA_SPREAD_R3_CELLS);
-			const int k = ek > ACC_AA_FIRST ? (int)lround(ek) : ACC_AA_FIRST;
-			assert_true(p[ACC_SAMPLES] == (float)(1 + k));
-			if (range >= ACC_AA_SPREAD_R3_THRESHOLD)
-				assert_int_equal(k, ACC_AA_SPREAD_R3_CELLS);
-			double d = 0.0, v = 0.0;
-			for (int c = 0; c < 3; c++) {
-				const double m = 0.4 + 0.1 * c;
-				assert_close(p[c], (0.5 + k * m) / (1 + k), 1e-6, 0.0,
-					     "the base sample and the mean, 1 to the cells");
-				const double den = (double)p[c] * p[c] + METRICS_RELMSE_EPS;
-				d += (m - 0.5) * (m - 0.5) / den / 3.0;
-				v += spread[x] * spread[x] / 3.0 / 4.0 / den / 3.0;
+		/* the lighter renders for spread error (+A0.1 +R3 and +A0.3
+		 * +R2, whatever the depth): 36 and 16 cells a subdivided pixel;
+		 * a pixel whose render pixels differ by less than the render's
+		 * threshold was not subdivided, and its spread is its error's
+		 * as it stands */
+		static const struct {
+			int edges, cells;
+			double t;
+		} light[2] = {
+			{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_R3_CELLS, ACC_AA_SPREAD_R3_THRESHOLD },
+			{ ACC_AA_FOR_SPREAD_FLOOR, ACC_AA_SPREAD_FLOOR_CELLS,
+			  ACC_AA_SPREAD_FLOOR_THRESHOLD },
+		};
+		for (int li = 0; li < 2; li++) {
+			assert_true(accum_for_spread(light[li].edges));
+			assert_true(accum_spread_light_threshold(light[li].edges) == light[li].t);
+			make_acc(&spr, 5, 1, flat_value);
+			assert_int_equal(accum_merge_aa_region(&spr, &big, 0, ACC_AA, depth,
+								 light[li].edges, 0, 0, 4, 0, 1,
+								 &folded, err, sizeof(err)), 0);
+			assert_int_equal(folded, 5);
+			for (int x = 0; x < 5; x++) {
+				const float *p = accpx(&spr, (size_t)x);
+				const double range = 3.0 * spread[x];
+				const double ek = edge_cells_want(range, light[li].cells);
+				const int k = ek > ACC_AA_FIRST ? (int)lround(ek) : ACC_AA_FIRST;
+				assert_true(p[ACC_SAMPLES] == (float)(1 + k));
+				if (range >= ACC_AA_THRESHOLD)
+					assert_int_equal(k, light[li].cells);
+				double d = 0.0, v = 0.0;
+				for (int c = 0; c < 3; c++) {
+					const double m = 0.4 + 0.1 * c;
+					assert_close(p[c], (0.5 + k * m) / (1 + k), 1e-6, 0.0,
+						     "the base sample and the mean, 1 to the cells");
+					const double den = (double)p[c] * p[c] + METRICS_RELMSE_EPS;
+					d += (m - 0.5) * (m - 0.5) / den / 3.0;
+					v += spread[x] * spread[x] / 3.0 / 4.0 / den / 3.0;
+				}
+				const double full = ((double)k * k + 1.0) / ((1.0 + k) * (1.0 + k)) * d;
+				const double kd = range / ACC_AA_SPREAD_RANGE * light[li].cells /
+						  accum_edge_cells(ACC_AA_SPREAD_DEPTH);
+				const double div = range < light[li].t ? 1.0 : kd > 1.0 ? kd : 1.0;
+				/* (pixel 3's range, 0.3, is +A0.3's threshold itself:
+				 * which side the floats put it on is not the point) */
+				if (!(li == 1 && x == 3))
+					assert_close(p[ACC_DIFF], full < v / div ? full : v / div,
+						     1e-4, 1e-12,
+						     "a lighter render's error: the spread, over range "
+						     "/ 0.012 in proportion to its cells where "
+						     "subdivided");
+				/* 0.06 below either threshold: not subdivided, the
+				 * spread whole; 0.9 above both: divided */
+				if (x == 2)
+					assert_close(p[ACC_DIFF], full < v ? full : v, 1e-4, 1e-12,
+						     "below the threshold the spread whole");
+				if (x == 4)
+					assert_true(p[ACC_DIFF] < v);
+				assert_true(accum_has_scale(&spr, (size_t)x, ACC_AA_SPREAD_BIT));
+				assert_true(accum_has_scale(&spr, (size_t)x, ACC_AA_EDGE));
 			}
-			const double full = ((double)k * k + 1.0) / ((1.0 + k) * (1.0 + k)) * d;
-			const double kd = range / ACC_AA_SPREAD_RANGE * ACC_AA_SPREAD_R3_CELLS /
-					  accum_edge_cells(ACC_AA_SPREAD_DEPTH);
-			const double div = range < ACC_AA_SPREAD_R3_THRESHOLD ? 1.0
-					   : kd > 1.0 ? kd : 1.0;
-			assert_close(p[ACC_DIFF], full < v / div ? full : v / div, 1e-4, 1e-12,
-				     "+A0.1 +R3's error: the spread, over range / 0.012 in "
-				     "proportion to 36 cells where subdivided");
-			if (x == 2)	/* 0.06: not subdivided, the spread whole */
-				assert_close(p[ACC_DIFF], full < v ? full : v, 1e-4, 1e-12,
-					     "below +A0.1 the spread whole");
-			assert_true(accum_has_scale(&spr, (size_t)x, ACC_AA_SPREAD_BIT));
-			assert_true(accum_has_scale(&spr, (size_t)x, ACC_AA_EDGE));
+			image_release(&spr);
 		}
-		image_release(&spr);
 		if (depth < ACC_AA_DEPTH)
 			image_release(&acc);	/* the deepest goes on below */
 		image_release(&few);
@@ -2395,16 +2416,18 @@ static void test_radiosity_trace(void **state)
 /* 7. The regions file round-trips; a bad line is reported with its number. */
 static void test_regions_file(void **state)
 {
-	struct plan_region rs[5] = {
+	struct plan_region rs[6] = {
 		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1, 0, 0, 0 },
 		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2, 0, 0, 0 },
 		{ 63, 47, 63, 47, ACC_AA, 1, 0.1, 0.3, ACC_GRID_FRAME, 3, ACC_AA_FOR_EDGES },
 		{ 8, 0, 15, 7, ACC_AA, 1, 0.1, 0.3, ACC_GRID_FRAME, 3, ACC_AA_FOR_SPREAD },
 		{ 16, 0, 23, 7, ACC_AA, 1, 0.1, 0.3, ACC_GRID_FRAME, 3, ACC_AA_FOR_SPREAD_R3 },
+		{ 24, 0, 31, 7, ACC_AA, 1, 0.1, 0.3, ACC_GRID_FRAME, 2, ACC_AA_FOR_SPREAD_FLOOR },
 	};
 	static char o0[] = "r0.exr", o1[] = "a dir/with spaces/region 1.exr",
-		o2[] = "/tmp/x y\tz 4\t1.exr", o3[] = "p1-r3-aa.exr", o4[] = "p1-r4-aa.exr";
-	char *outs[5] = { o0, o1, o2, o3, o4 };
+		o2[] = "/tmp/x y\tz 4\t1.exr", o3[] = "p1-r3-aa.exr", o4[] = "p1-r4-aa.exr",
+		o5[] = "p1-r5-aa.exr";
+	char *outs[6] = { o0, o1, o2, o3, o4, o5 };
 	struct plan pl;
 	struct plan_region *got;
 	char **gout, path[256], err[512];
@@ -2415,15 +2438,15 @@ static void test_regions_file(void **state)
 	(void)state;
 	memset(&pl, 0, sizeof(pl));
 	pl.regions = rs;
-	pl.nregions = 5;
+	pl.nregions = 6;
 	scratch(path, sizeof(path), "regions file.txt");
 	f = fopen(path, "w");
 	assert_non_null(f);
 	assert_int_equal(plan_regions_write(f, &pl, 7, outs), 0);
 	assert_int_equal(fclose(f), 0);
 	assert_int_equal(plan_regions_read(path, &got, &gout, &passes, &n, err, sizeof(err)), 0);
-	assert_int_equal(n, 5);
-	for (size_t k = 0; k < 5; k++) {
+	assert_int_equal(n, 6);
+	for (size_t k = 0; k < 6; k++) {
 		assert_int_equal(passes[k], 7);
 		assert_int_equal(got[k].x0, rs[k].x0);
 		assert_int_equal(got[k].y0, rs[k].y0);
@@ -2459,7 +2482,7 @@ static void test_regions_file(void **state)
 
 	/* line 3 has a letter for y0; then a line without an output; then,
 	 * under the header naming depth and edges, lines without them, with
-	 * a depth out of range, with edges on a scaled region, with edges 4 */
+	 * a depth out of range, with edges on a scaled region, with edges 5 */
 #define HDR "# povpress regions: pass x0 y0 x1 y1 scale output depth edges\n"
 	static const char *const bad[] = {
 		"# header\n1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\tx\t3\t3\t2\tb.exr\t0\t0\n",
@@ -2467,7 +2490,7 @@ static void test_regions_file(void **state)
 		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t1\n1\t0\t0\t3\t3\t2\tb.exr\n",
 		HDR "1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\t0\t3\t3\t0\tb.exr\t6\t0\n",
 		HDR "\n1\t0\t0\t3\t3\t2\ta.exr\t3\t1\n",
-		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t0\n1\t0\t0\t3\t3\t0\tb.exr\t4\t4\n",
+		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t0\n1\t0\t0\t3\t3\t0\tb.exr\t4\t5\n",
 		/* a sign; no header at all, old-format lines */
 		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t0\n1\t0\t0\t3\t3\t0\tb.exr\t+4\t0\n",
 		"# x\n1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\t0\t3\t3\t2\tb.exr\n",
@@ -2586,6 +2609,13 @@ static void test_plan_job(void **state)
 		assert_aa_options(&job, "+AM1", "+A0.1", "+R3", "+J");
 		assert_true(fabs(strtod("0.1", NULL) - ACC_AA_SPREAD_R3_THRESHOLD) < 1e-12);
 		assert_int_equal(ACC_AA_SPREAD_R3_CELLS, 4 * 3 * 3);
+		/* the lightest: +A0.3 +R2, 2 x 2 render pixels of 2 x 2 */
+		r.edges = ACC_AA_FOR_SPREAD_FLOOR;
+		plan_job(&base, &r, "out/a5.exr", &region, aextra, &job);
+		assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
+		assert_aa_options(&job, "+AM1", "+A0.3", "+R2", "+J");
+		assert_true(fabs(strtod("0.3", NULL) - ACC_AA_SPREAD_FLOOR_THRESHOLD) < 1e-12);
+		assert_int_equal(ACC_AA_SPREAD_FLOOR_CELLS, 4 * 2 * 2);
 		r.edges = ACC_AA_FOR_FEW;
 	}
 	r.depth = 0;
