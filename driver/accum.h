@@ -238,7 +238,7 @@ enum {
  * the others: +AM1 +A0.3 +R2 +J at twice the size (its depth column is
  * ignored), which costs little more than scale 2's plain render at twice
  * the size and on textures errs far less (POV-Ray alone at 1280x960,
- * box-averaged, one run each, 2026-12-05 02:22 UTC: Debian's granite
+ * box-averaged, one run each, 2026-12-05 02:25 UTC: Debian's granite
  * 3.7e-4 in 2.22 s against 1.4e-3 in 1.08 s without antialiasing,
  * noise_generator 7.2e-5 in 1.39 against 2.2e-4 in 1.01, swirlbox 4.2e-4 in
  * 1.74 against 1.8e-3 in 1.12, var_refl 7.8e-4 in 2.56 against 3.2e-3 in

@@ -1917,7 +1917,7 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
  * threshold (soft_shadows at 640x480: 5.1 CPU s for 281,600 pixels, 85,840
  * of them such, at 0.87 microseconds a sample, 55 a pixel at +R4); the pass is
  * planned as scale 2, so under a budget the renders are taken at the
- * first of spread_levels (+R4, +A0.1 +R3 or +R2) where SPREAD_MARGIN
+ * first of spread_levels (+R4, +A0.1 +R3, +R2 or +A0.3 +R2) where its margin
  * times that cost fits what the pass may spend, priced at
  * the base pass's measured cost of a sample, not the plan's power of two
  * (soft_shadows' 0.87 microseconds went at times to 0.48, the +R2 renders
@@ -1935,26 +1935,42 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
 #define SPREAD_SAMPLE_S 1.5e-6
 #define SPREAD_MARGIN 1.25
 /*
+ * The lighter levels' margin.  Their price missed their CPU as the
+ * others' does: over soft_shadows, thin_geometry and Debian's var_refl,
+ * noise_generator, swirlbox and granite at 640x480 (`--budget 40 --target
+ * 1e-6 --max-passes 1`, each level forced by a scratch switch, 2026-12-05
+ * 02:40 UTC) the pass's POV-Ray CPU was 0.85 to 1.41 times the price at
+ * every level, median 1.17, thin_geometry and var_refl 1.26 to 1.41.  At
+ * SPREAD_MARGIN thin_geometry under --budget 2 took +A0.1 +R3 priced at
+ * 1.7 core-s of 2.2, and in two runs of three one of its four renders was
+ * stopped at the deadline (relMSE 4.8e-3 to 5.7e-3, against 5.7e-4 by
+ * +R2 and 2.5e-4 by +A0.1 +R3 whole).
+ */
+#define SPREAD_MARGIN_LIGHT 1.4
+/*
  * The renders a pass's scale-2 regions may become, in the order tried:
  * +A0.03 +R4 (ACC_AA_SPREAD_DEPTH), then under a budget that it does not
  * fit the lighter +A0.1 +R3 (ACC_AA_FOR_SPREAD_R3, accum.h), +A0.03 +R2
  * and +A0.3 +R2 (ACC_AA_FOR_SPREAD_FLOOR); each with the colour distance
  * that has POV-Ray subdivide a render pixel, the samples of a subdivided
- * pixel and its name for the progress display.
+ * pixel, its name for the progress display and the margin its price is
+ * taken with.
  */
 static const struct spread_level {
 	int edges, depth;
 	double threshold;
 	int cells;
 	const char *name;
+	double margin;
 } spread_levels[] = {
 	{ ACC_AA_FOR_SPREAD, ACC_AA_SPREAD_DEPTH, ACC_AA_SPREAD_THRESHOLD, 1 << (2 * 3),
-	  "+A0.03 +R4" },
+	  "+A0.03 +R4", SPREAD_MARGIN },
 	{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_DEPTH, ACC_AA_SPREAD_R3_THRESHOLD,
-	  ACC_AA_SPREAD_R3_CELLS, "+A0.1 +R3" },
-	{ ACC_AA_FOR_SPREAD, 2, ACC_AA_SPREAD_THRESHOLD, 1 << (2 * 2), "+A0.03 +R2" },
+	  ACC_AA_SPREAD_R3_CELLS, "+A0.1 +R3", SPREAD_MARGIN_LIGHT },
+	{ ACC_AA_FOR_SPREAD, 2, ACC_AA_SPREAD_THRESHOLD, 1 << (2 * 2), "+A0.03 +R2",
+	  SPREAD_MARGIN },
 	{ ACC_AA_FOR_SPREAD_FLOOR, 2, ACC_AA_SPREAD_FLOOR_THRESHOLD, ACC_AA_SPREAD_FLOOR_CELLS,
-	  "+A0.3 +R2" },
+	  "+A0.3 +R2", SPREAD_MARGIN_LIGHT },
 };
 enum { NSPREAD = sizeof spread_levels / sizeof spread_levels[0] };
 _Static_assert(ACC_AA_SPREAD_DEPTH == 3, "spread_levels' first cells are +R4's");
@@ -2008,7 +2024,8 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 		sums[t] = sum[t];
 	int t = 0;
 	if (r->budget > 0.0) {
-		while (t < NSPREAD && !fits(SPREAD_MARGIN, sum[t], worst[t], pp, left))
+		while (t < NSPREAD &&
+		       !fits(spread_levels[t].margin, sum[t], worst[t], pp, left))
 			t++;
 		if (t > 0 && t < NSPREAD && !(sum[t] >= SPREAD_R2_SHARE * pp->budget))
 			t = NSPREAD;	/* see SPREAD_R2_SHARE */
@@ -2322,10 +2339,10 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 				int at = 0;
 				for (int l = 0; l < NSPREAD && at >= 0 && at < (int)sizeof(what); l++)
 					at += snprintf(what + at, sizeof(what) - (size_t)at,
-						       "%s%.1f%s at %s", l ? ", " : "", sums[l],
+						       "%s%.2f%s at %s", l ? ", " : "", sums[l],
 						       l ? "" : " core-s", spread_levels[l].name);
 				progress(r, "pass %d: the error is spread: POV-Ray's +AM1 over the "
-					 "scale-2 regions about %s; the pass may spend %.1f", pass,
+					 "scale-2 regions about %s; the pass may spend %.2f", pass,
 					 what, pp.budget);
 			}
 		}

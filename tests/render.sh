@@ -586,19 +586,21 @@ check "... resumed with --sampler scale, the run goes by it" \
 	-v --report "$T/tm.json" -- +WT1 2>"$T/tm.log" || bad "soft_shadows, target 0.5: render failed"
 check "... no pass, no choice: the report says auto" grep -q '"sampler_chosen": "auto"' "$T/tm.json"
 check "... and no line says otherwise" test "$(grep -c 'no scale 2' "$T/tm.log")" -eq 0
-# spread_level SCENE TAG LOW HIGH: the first refinement pass of SCENE at
+# spread_level SCENE TAG LOW HIGH MLOW MHIGH: the first refinement pass of SCENE at
 # 320x240 on one core, the cost of a sample pinned at 1e-6 s (spread error,
 # its scale-2 regions rendered by POV-Ray's +AM1 at twice the size), under
 # a budget that fits the render level LOW (as -v names it) but not the one
-# tried before it, HIGH: a run under 30 s ($T/TAG-30.exr) prints each
-# level's price and what the pass may spend, (budget - elapsed - latency
-# - 0.2) x 0.8 core-s on one core, and the budget is moved so that the pass
-# may spend the geometric middle of 1.25 times the two ($T/TAG.exr, its
+# tried before it, HIGH, their prices taken with the margins MLOW and MHIGH
+# (render.c's SPREAD_MARGIN and SPREAD_MARGIN_LIGHT): a run under 30 s
+# ($T/TAG-30.exr) prints each level's price and what the pass may spend,
+# (budget - elapsed - latency - 0.2) x 0.8 core-s on one core, and the
+# budget is moved so that the pass may spend the geometric middle of the
+# two prices with their margins ($T/TAG.exr, its
 # log TAG.log and report TAG.json; moved once more where it missed).  Checks that the pass so took LOW,
 # rendered at twice the size, marked its pixels and ended within the
 # budget; fails when a run fails.
 spread_level() {
-	local scene=$1 tag=$2 lo=$3 hi=$4 b plo phi may m2 a1 try
+	local scene=$1 tag=$2 lo=$3 hi=$4 mlo=$5 mhi=$6 b plo phi may m2 a1 try
 	local sp=(taskset -c 0 "$PP" render "$scene" -W 320 -H 240 --target 1e-6 --max-passes 1
 		--cost-sample 1e-6 --cost-job 0.05 -v --keep-workdir)
 	"${sp[@]}" -o "$T/$tag-30.exr" --budget 30 -- +WT1 2>"$T/$tag-30.log" ||
@@ -615,8 +617,8 @@ spread_level() {
 	# a second try, moved by what the first missed by, where the times
 	# of the base pass and the analysis moved between the runs
 	for try in 1 2; do
-		b=$(awk -v b="$b" -v h="${phi:-1}" -v l="${plo:-1}" -v m="${may:-1}" \
-			'BEGIN { printf "%.2f", b - (m - 1.25 * sqrt(h * l)) / 0.8 }')
+		b=$(awk -v b="$b" -v h="${phi:-1}" -v l="${plo:-1}" -v m="${may:-1}" -v x="$mlo" \
+			-v y="$mhi" 'BEGIN { printf "%.2f", b - (m - sqrt(x * l * y * h)) / 0.8 }')
 		"${sp[@]}" -o "$T/$tag.exr" --budget "$b" --report "$T/$tag.json" -- +WT1 \
 			2>"$T/$tag.log" ||
 			{ bad "$(basename "$scene") 320x240 --budget $b: render failed"; return 1; }
@@ -624,10 +626,10 @@ spread_level() {
 		phi=$(price "$T/$tag.log" "$hi")
 		m2=$(spend "$T/$tag.log")
 		may=$m2
-		num 'a >= 1.25 * b && a < 1.25 * c' "${m2:-0}" "${plo:-1}" "${phi:-0}" && break
+		num "a >= $mlo * b && a < $mhi * c" "${m2:-0}" "${plo:-1}" "${phi:-0}" && break
 	done
-	check "... under $b s the pass may spend $m2, between 1.25 times $lo's $plo and $hi's $phi" \
-		num 'a >= 1.25 * b && a < 1.25 * c' "${m2:-0}" "${plo:-1}" "${phi:-0}"
+	check "... under $b s the pass may spend $m2, between $mlo times $lo's $plo and $mhi times $hi's $phi" \
+		num "a >= $mlo * b && a < $mhi * c" "${m2:-0}" "${plo:-1}" "${phi:-0}"
 	check "... so $lo in scale 2's place" grep -q "(+AM1) in place of scale 2, $lo\$" "$T/$tag.log"
 	check "... no region of scale 2" \
 		awk -F'\t' '$1 == 1 && $6 == 2 { f = 1 } END { exit f }' "$T/$tag.exr.work/regions.tsv"
@@ -680,7 +682,7 @@ if ref=$(W=320 H=240 reference "$scene"); then
 		test -z "$(compgen -G "$T/am1-scale.exr.work/p*-aa.exr")"
 	# under a budget that +A0.03 +R4 does not fit but the lighter +A0.1 +R3
 	# does (ACC_AA_FOR_SPREAD_R3), that one (spread_level, above)
-	if spread_level "$scene" r3 "+A0.1 +R3" "+A0.03 +R4"; then
+	if spread_level "$scene" r3 "+A0.1 +R3" "+A0.03 +R4" 1.4 1.25; then
 		check "... its regions file says so (scale 0, edges 3)" \
 			awk -F'\t' '$1 == 1 && $6 == 0 && $9 == 3 { f = 1 } END { exit !f }' \
 			"$T/r3.exr.work/regions.tsv"
@@ -703,7 +705,7 @@ fi
 # less than scale 2 in the same pass under the same budget (measured 2.1e-3
 # against 6.1e-3; on soft_shadows, no texture, the two erred alike).
 scene="$SC/horizon_texture.pov"
-if spread_level "$scene" floor "+A0.3 +R2" "+A0.03 +R2"; then
+if spread_level "$scene" floor "+A0.3 +R2" "+A0.03 +R2" 1.4 1.25; then
 	check "... its regions file says so (scale 0, edges 4)" \
 		awk -F'\t' '$1 == 1 && $6 == 0 && $9 == 4 { f = 1 } END { exit !f }' \
 		"$T/floor.exr.work/regions.tsv"
