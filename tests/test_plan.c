@@ -2601,21 +2601,27 @@ static void test_plan_job(void **state)
 		assert_aa_options(&job, "+AM1", "+A0.03", want, "+J");
 		assert_int_equal(4 * (1 << (d - 1)) * (1 << (d - 1)), accum_edge_cells(d));
 		assert_true(fabs(strtod("0.03", NULL) - ACC_AA_SPREAD_THRESHOLD) < 1e-12);
-		/* the lighter render for spread error: +A0.1 +R3 at any
-		 * depth, 2 x 2 render pixels of 3 x 3 samples */
-		r.edges = ACC_AA_FOR_SPREAD_R3;
-		plan_job(&base, &r, "out/a4.exr", &region, aextra, &job);
-		assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
-		assert_aa_options(&job, "+AM1", "+A0.1", "+R3", "+J");
-		assert_true(fabs(strtod("0.1", NULL) - ACC_AA_SPREAD_R3_THRESHOLD) < 1e-12);
-		assert_int_equal(ACC_AA_SPREAD_R3_CELLS, 4 * 3 * 3);
-		/* the lightest: +A0.3 +R2, 2 x 2 render pixels of 2 x 2 */
-		r.edges = ACC_AA_FOR_SPREAD_FLOOR;
-		plan_job(&base, &r, "out/a5.exr", &region, aextra, &job);
-		assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
-		assert_aa_options(&job, "+AM1", "+A0.3", "+R2", "+J");
-		assert_true(fabs(strtod("0.3", NULL) - ACC_AA_SPREAD_FLOOR_THRESHOLD) < 1e-12);
-		assert_int_equal(ACC_AA_SPREAD_FLOOR_CELLS, 4 * 2 * 2);
+		/* the lighter renders for spread error at any depth: +A0.1
+		 * +R3, 2 x 2 render pixels of 3 x 3 samples, and +A0.3 +R2,
+		 * of 2 x 2 */
+		static const struct {
+			int edges, cells, want_cells;
+			const char *a, *rr;
+			double t;
+		} light[2] = {
+			{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_R3_CELLS, 4 * 3 * 3, "+A0.1", "+R3",
+			  ACC_AA_SPREAD_R3_THRESHOLD },
+			{ ACC_AA_FOR_SPREAD_FLOOR, ACC_AA_SPREAD_FLOOR_CELLS, 4 * 2 * 2, "+A0.3", "+R2",
+			  ACC_AA_SPREAD_FLOOR_THRESHOLD },
+		};
+		for (int li = 0; li < 2; li++) {
+			r.edges = light[li].edges;
+			plan_job(&base, &r, "out/a4.exr", &region, aextra, &job);
+			assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
+			assert_aa_options(&job, "+AM1", light[li].a, light[li].rr, "+J");
+			assert_true(fabs(strtod(light[li].a + 2, NULL) - light[li].t) < 1e-12);
+			assert_int_equal(light[li].cells, light[li].want_cells);
+		}
 		r.edges = ACC_AA_FOR_FEW;
 	}
 	r.depth = 0;
