@@ -252,17 +252,34 @@ static double edge_cells(double range, double cells)
 	return range >= ACC_AA_THRESHOLD ? cells : pow(cells, log10(range / lo));
 }
 
-/* What the spread of a pixel's render pixels is divided by for the error
- * of their mean, in a render taken for spread error (+AM1) whose render
- * pixels' colour distance is range and whose subdivided pixels have that
- * many cells (see ACC_AA_SPREAD_RANGE): range / ACC_AA_SPREAD_RANGE at
- * ACC_AA_SPREAD_DEPTH's cells, in proportion to them at another depth,
- * at least 1. */
-static double spread_division(double range, double cells, int edges)
+struct accum_spread accum_spread_render(int edges, int depth)
 {
-	if (range < accum_spread_light_threshold(edges))
+	/* ACC_AA_FOR_SPREAD's grid side for the same samples as +AM2's
+	 * cells at each depth */
+	static const char *const side[] = { "+R1", "+R2", "+R4", "+R8", "+R16" };
+	_Static_assert(ACC_AA_DEPTH == 5, "a side for every depth");
+	if (edges == ACC_AA_FOR_SPREAD_R3)
+		return (struct accum_spread){ "+A0.1", "+R3", ACC_AA_SPREAD_R3_THRESHOLD,
+					      ACC_AA_SPREAD_R3_CELLS, 1 };
+	if (edges == ACC_AA_FOR_SPREAD_FLOOR)
+		return (struct accum_spread){ "+A0.3", "+R2", ACC_AA_SPREAD_FLOOR_THRESHOLD,
+					      ACC_AA_SPREAD_FLOOR_CELLS, 1 };
+	const int d = accum_aa_depth(depth), dd = d >= 1 && d <= ACC_AA_DEPTH ? d : ACC_AA_DEPTH_V1;
+	return (struct accum_spread){ "+A0.03", side[dd - 1], ACC_AA_SPREAD_THRESHOLD,
+				      accum_edge_cells(dd), 0 };
+}
+
+/* What the spread of a pixel's render pixels is divided by for the error
+ * of their mean, in a render taken for spread error (+AM1), sp, whose
+ * render pixels' colour distance is range (see ACC_AA_SPREAD_RANGE):
+ * range / ACC_AA_SPREAD_RANGE at ACC_AA_SPREAD_DEPTH's cells, in
+ * proportion to them at another depth or render, at least 1; 1 below a
+ * lighter render's threshold. */
+static double spread_division(double range, const struct accum_spread *sp)
+{
+	if (sp->light && range < sp->threshold)
 		return 1.0;
-	const double k = range / ACC_AA_SPREAD_RANGE * cells /
+	const double k = range / ACC_AA_SPREAD_RANGE * sp->cells /
 			 (double)accum_edge_cells(ACC_AA_SPREAD_DEPTH);
 	return k > 1.0 ? k : 1.0;
 }
@@ -274,9 +291,8 @@ static double spread_division(double range, double cells, int edges)
 static long merge_aa(struct image *acc, const struct image *img, int oy, const int ch[3],
 		     int f, int x0, int y0, int x1, int y1, int pass, int depth, int edges)
 {
-	int cells = edges == ACC_AA_FOR_SPREAD_R3	? ACC_AA_SPREAD_R3_CELLS
-		    : edges == ACC_AA_FOR_SPREAD_FLOOR ? ACC_AA_SPREAD_FLOOR_CELLS
-						       : accum_edge_cells(accum_aa_depth(depth));
+	const struct accum_spread sp = accum_spread_render(edges, depth);
+	int cells = accum_for_spread(edges) ? sp.cells : accum_edge_cells(accum_aa_depth(depth));
 	if (!edges && cells > ACC_AA_FEW)
 		cells = ACC_AA_FEW;	/* see ACC_AA_FEW */
 	int n = aa_worth(acc, img, oy, ch, f, x0, y0, x1, y1);
@@ -321,7 +337,7 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			const double ec = first ? edge_cells(range, cells) : 1.0;
 			const double ek = !edge ? 1.0
 				: !accum_for_spread(edges) ? ec
-				: spread_division(range, cells, edges);
+				: spread_division(range, &sp);
 			int k = first ? (ec > ACC_AA_FIRST ? (int)lround(ec) : ACC_AA_FIRST)
 				      : own < 1.0 ? 1 : own < n ? (int)lround(own) : n;
 			/* taken for edges, the cells vary as the render pixels

@@ -232,7 +232,8 @@ enum {
  * (ACC_AA_THRESHOLD).
  */
 #define ACC_AA_SPREAD_R3_THRESHOLD 0.1
-#define ACC_AA_SPREAD_R3_CELLS 36
+#define ACC_AA_SPREAD_R3_SIDE 3
+#define ACC_AA_SPREAD_R3_CELLS (4 * ACC_AA_SPREAD_R3_SIDE * ACC_AA_SPREAD_R3_SIDE)
 /*
  * The lightest (ACC_AA_FOR_SPREAD_FLOOR), for a budget that fits none of
  * the others: +AM1 +A0.3 +R2 +J at twice the size (its depth column is
@@ -247,7 +248,8 @@ enum {
  * may leave a step of up to 0.3 between two of its pixels charged as 0.1.
  */
 #define ACC_AA_SPREAD_FLOOR_THRESHOLD 0.3
-#define ACC_AA_SPREAD_FLOOR_CELLS 16
+#define ACC_AA_SPREAD_FLOOR_SIDE 2
+#define ACC_AA_SPREAD_FLOOR_CELLS (4 * ACC_AA_SPREAD_FLOOR_SIDE * ACC_AA_SPREAD_FLOOR_SIDE)
 
 /* Whether a render in scale 2's place was taken for spread error (+AM1). */
 static inline int accum_for_spread(int edges)
@@ -255,14 +257,22 @@ static inline int accum_for_spread(int edges)
 	return edges >= ACC_AA_FOR_SPREAD && edges <= ACC_AA_FOR_SPREAD_FLOOR;
 }
 
-/* The threshold of a render for spread error whose depth column is
- * ignored, the lighter ones (0 for ACC_AA_FOR_SPREAD and others). */
-static inline double accum_spread_light_threshold(int edges)
-{
-	return edges == ACC_AA_FOR_SPREAD_R3	  ? ACC_AA_SPREAD_R3_THRESHOLD
-	       : edges == ACC_AA_FOR_SPREAD_FLOOR ? ACC_AA_SPREAD_FLOOR_THRESHOLD
-						  : 0.0;
-}
+/*
+ * The render a region taken for spread error stands for, read by the
+ * fold, the POV-Ray job and the planner alike: POV-Ray's +AM1 with the
+ * threshold option a (the colour distance `threshold`) and the grid option
+ * r, so that a pixel it subdivided has `cells` samples (2 x 2 render
+ * pixels of r x r).  ACC_AA_FOR_SPREAD is +A0.03 with a grid of
+ * 2^(depth-1) a side; the lighter ones (`light`) have their own whatever
+ * the depth, and their pixel below the threshold is charged its render
+ * pixels' spread whole.
+ */
+struct accum_spread {
+	const char *a, *r;
+	double threshold;
+	int cells, light;
+};
+struct accum_spread accum_spread_render(int edges, int depth);
 /*
  * Such a render's pixel is charged its render pixels' spread (their mean's
  * variance) divided by its range (the colour distance of its render

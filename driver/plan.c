@@ -1192,23 +1192,14 @@ void plan_job(const struct pov_job *base, const struct plan_region *r, const cha
 	if (r->scale == ACC_AA) {
 		/* POV-Ray's own adaptive antialiasing, jittered (accum.h) */
 		static const char *const depth[] = { "+R1", "+R2", "+R3", "+R4", "+R5" };
-		/* +AM1's grid side for the same samples as +AM2's cells */
-		static const char *const side[] = { "+R1", "+R2", "+R4", "+R8", "+R16" };
 		_Static_assert(ACC_AA_DEPTH == 5, "a +R for every depth");
 		const int d = accum_aa_depth(r->depth);
 		const int di = (d >= 1 && d <= ACC_AA_DEPTH ? d : ACC_AA_DEPTH_V1) - 1;
-		if (r->frame > 0 && r->edges == ACC_AA_FOR_SPREAD) {
+		if (r->frame > 0 && accum_for_spread(r->edges)) {
+			const struct accum_spread sp = accum_spread_render(r->edges, r->depth);
 			extra[job->nextra++] = "+AM1";
-			extra[job->nextra++] = "+A0.03";	/* ACC_AA_SPREAD_THRESHOLD */
-			extra[job->nextra++] = side[di];
-		} else if (r->frame > 0 && r->edges == ACC_AA_FOR_SPREAD_R3) {
-			extra[job->nextra++] = "+AM1";
-			extra[job->nextra++] = "+A0.1";	/* ACC_AA_SPREAD_R3_THRESHOLD */
-			extra[job->nextra++] = "+R3";
-		} else if (r->frame > 0 && r->edges == ACC_AA_FOR_SPREAD_FLOOR) {
-			extra[job->nextra++] = "+AM1";
-			extra[job->nextra++] = "+A0.3";	/* ACC_AA_SPREAD_FLOOR_THRESHOLD */
-			extra[job->nextra++] = "+R2";
+			extra[job->nextra++] = sp.a;
+			extra[job->nextra++] = sp.r;
 		} else {
 			extra[job->nextra++] = "+AM2";
 			extra[job->nextra++] = r->frame > 0 ? "+A0.1" : "+A0.0";

@@ -1690,26 +1690,36 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
  * aa_depth() covers the dearest.
  */
 #define EDGE_SAMPLES 100.0
-/* The pixels of region g of acc that count as edges for the cost above:
- * whose colour distance to a neighbour reaches t. */
-static long edge_pixels(const struct image *acc, const struct plan_region *g, double t)
+/* The pixels of region g of acc that count as edges for the cost above,
+ * whose colour distance to a neighbour reaches t[j], for each of the n
+ * thresholds into e[j], in one scan; edge_pixels() for one. */
+static void edge_counts(const struct image *acc, const struct plan_region *g, const double *t,
+			int n, long *e)
 {
-	long e = 0;
+	for (int j = 0; j < n; j++)
+		e[j] = 0;
 	for (int y = g->y0; y <= g->y1; y++)
 		for (int x = g->x0; x <= g->x1; x++) {
 			const float *o = acc->px + ((size_t)y * acc->w + x) * ACC_NCH;
-			int edge = 0;
-			for (int k = 0; k < 4 && !edge; k++) {
+			double most = -1.0;	/* the largest distance to a neighbour */
+			for (int k = 0; k < 4; k++) {
 				const int nx = x + (k == 0) - (k == 1), ny = y + (k == 2) - (k == 3);
 				if (nx < 0 || ny < 0 || nx >= acc->w || ny >= acc->h)
 					continue;
 				const float *q = acc->px + ((size_t)ny * acc->w + nx) * ACC_NCH;
 				double dist = fabs((double)q[0] - o[0]) + fabs((double)q[1] - o[1]) +
 					      fabs((double)q[2] - o[2]);
-				edge = dist >= t;
+				most = dist > most ? dist : most;
 			}
-			e += edge;
+			for (int j = 0; j < n; j++)
+				e[j] += most >= t[j];
 		}
+}
+
+static long edge_pixels(const struct image *acc, const struct plan_region *g, double t)
+{
+	long e;
+	edge_counts(acc, g, &t, 1, &e);
 	return e;
 }
 
@@ -1951,29 +1961,20 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
  * The renders a pass's scale-2 regions may become, in the order tried:
  * +A0.03 +R4 (ACC_AA_SPREAD_DEPTH), then under a budget that it does not
  * fit the lighter +A0.1 +R3 (ACC_AA_FOR_SPREAD_R3, accum.h), +A0.03 +R2
- * and +A0.3 +R2 (ACC_AA_FOR_SPREAD_FLOOR); each with the colour distance
- * that has POV-Ray subdivide a render pixel, the samples of a subdivided
- * pixel, its name for the progress display and the margin its price is
- * taken with.
+ * and +A0.3 +R2 (ACC_AA_FOR_SPREAD_FLOOR), each as its edges and depth
+ * (accum_spread_render() has its threshold and cells) with the margin its
+ * price is taken with.
  */
 static const struct spread_level {
 	int edges, depth;
-	double threshold;
-	int cells;
-	const char *name;
 	double margin;
 } spread_levels[] = {
-	{ ACC_AA_FOR_SPREAD, ACC_AA_SPREAD_DEPTH, ACC_AA_SPREAD_THRESHOLD, 1 << (2 * 3),
-	  "+A0.03 +R4", SPREAD_MARGIN },
-	{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_DEPTH, ACC_AA_SPREAD_R3_THRESHOLD,
-	  ACC_AA_SPREAD_R3_CELLS, "+A0.1 +R3", SPREAD_MARGIN_LIGHT },
-	{ ACC_AA_FOR_SPREAD, 2, ACC_AA_SPREAD_THRESHOLD, 1 << (2 * 2), "+A0.03 +R2",
-	  SPREAD_MARGIN },
-	{ ACC_AA_FOR_SPREAD_FLOOR, 2, ACC_AA_SPREAD_FLOOR_THRESHOLD, ACC_AA_SPREAD_FLOOR_CELLS,
-	  "+A0.3 +R2", SPREAD_MARGIN_LIGHT },
+	{ ACC_AA_FOR_SPREAD, ACC_AA_SPREAD_DEPTH, SPREAD_MARGIN },
+	{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_DEPTH, SPREAD_MARGIN_LIGHT },
+	{ ACC_AA_FOR_SPREAD, 2, SPREAD_MARGIN },
+	{ ACC_AA_FOR_SPREAD_FLOOR, 2, SPREAD_MARGIN_LIGHT },
 };
 enum { NSPREAD = sizeof spread_levels / sizeof spread_levels[0] };
-_Static_assert(ACC_AA_SPREAD_DEPTH == 3, "spread_levels' first cells are +R4's");
 /*
  * Below the first level a render is taken only where the pass so spends at
  * least this share of what it may.  Where it would spend less, passes follow it, and
@@ -1995,39 +1996,41 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 	    r->focal || !(r->cost_sample <= SPREAD_SAMPLE_S) || !has_scale2(pl) ||
 	    sparse_error(r, sparse))
 		return 0;
-	/* each scale-2 region's price at each level, the pass's and its
-	 * dearest render's */
+	/* each scale-2 region's price at each level, the pass's (sums) and
+	 * its dearest render's; each region's pixels that differ from a
+	 * neighbour by each level's threshold, in one scan */
 	double *price = calloc(pl->nregions * NSPREAD, sizeof(*price));
 	if (!price)
 		return 0;
-	double sum[NSPREAD] = { 0.0 }, worst[NSPREAD] = { 0.0 };
+	struct accum_spread sp[NSPREAD];
+	double th[NSPREAD], worst[NSPREAD] = { 0.0 };
+	for (int t = 0; t < NSPREAD; t++) {
+		sp[t] = accum_spread_render(spread_levels[t].edges, spread_levels[t].depth);
+		th[t] = sp[t].threshold;
+	}
 	for (size_t k = 0; k < pl->nregions; k++) {
 		const struct plan_region *g = &pl->regions[k];
 		if (g->scale != 2) {	/* the pass's other renders, as planned */
 			for (int t = 0; t < NSPREAD; t++)
-				sum[t] += g->cost;
+				sums[t] += g->cost;
 			continue;
 		}
-		long e = -1;
+		long e[NSPREAD];
+		edge_counts(&r->acc, g, th, NSPREAD, e);
 		for (int t = 0; t < NSPREAD; t++) {
-			const struct spread_level *lv = &spread_levels[t];
-			if (t == 0 || lv->threshold != spread_levels[t - 1].threshold)
-				e = edge_pixels(&r->acc, g, lv->threshold);
-			const double c = aa_render_cost(pp, g, r->acc.w, r->cost_sample_measured, e,
-							lv->cells);
+			const double c = aa_render_cost(pp, g, r->acc.w, r->cost_sample_measured,
+							e[t], sp[t].cells);
 			price[k * NSPREAD + t] = c;
-			sum[t] += c;
+			sums[t] += c;
 			worst[t] = c > worst[t] ? c : worst[t];
 		}
 	}
-	for (int t = 0; t < NSPREAD; t++)
-		sums[t] = sum[t];
 	int t = 0;
 	if (r->budget > 0.0) {
 		while (t < NSPREAD &&
-		       !fits(spread_levels[t].margin, sum[t], worst[t], pp, left))
+		       !fits(spread_levels[t].margin, sums[t], worst[t], pp, left))
 			t++;
-		if (t > 0 && t < NSPREAD && !(sum[t] >= SPREAD_R2_SHARE * pp->budget))
+		if (t > 0 && t < NSPREAD && !(sums[t] >= SPREAD_R2_SHARE * pp->budget))
 			t = NSPREAD;	/* see SPREAD_R2_SHARE */
 	}
 	size_t n = 0;
@@ -2047,6 +2050,22 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 	}
 	free(price);
 	return n;
+}
+
+/* The -v line of spread_am1()'s prices, sums, against what the pass may
+ * spend. */
+static void spread_prices(struct run *r, int pass, const double sums[NSPREAD], double may)
+{
+	char what[256];
+	int at = 0;
+	for (int l = 0; l < NSPREAD && at >= 0 && at < (int)sizeof(what); l++) {
+		const struct accum_spread sp =
+			accum_spread_render(spread_levels[l].edges, spread_levels[l].depth);
+		at += snprintf(what + at, sizeof(what) - (size_t)at, "%s%.2f%s at %s %s",
+			       l ? ", " : "", sums[l], l ? "" : " core-s", sp.a, sp.r);
+	}
+	progress(r, "pass %d: the error is spread: POV-Ray's +AM1 over the scale-2 regions "
+		 "about %s; the pass may spend %.2f", pass, what, may);
 }
 
 /*
@@ -2334,17 +2353,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		} else {
 			double sums[NSPREAD];
 			naa = spread_am1(r, &pl, &pp, left, &sparse, sums);
-			if (r->verbose && r->budget > 0.0 && sums[0] > 0.0) {
-				char what[256];
-				int at = 0;
-				for (int l = 0; l < NSPREAD && at >= 0 && at < (int)sizeof(what); l++)
-					at += snprintf(what + at, sizeof(what) - (size_t)at,
-						       "%s%.2f%s at %s", l ? ", " : "", sums[l],
-						       l ? "" : " core-s", spread_levels[l].name);
-				progress(r, "pass %d: the error is spread: POV-Ray's +AM1 over the "
-					 "scale-2 regions about %s; the pass may spend %.2f", pass,
-					 what, pp.budget);
-			}
+			if (r->verbose && r->budget > 0.0 && sums[0] > 0.0)
+				spread_prices(r, pass, sums, pp.budget);
 		}
 		if (!early || prelaunch_cover(r, pass, &pl, &pre_idx))
 			break;
@@ -2456,12 +2466,12 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		edges = pl.regions[k].edges > edges ? pl.regions[k].edges : edges;
 	}
 	if (naa) {
-		/* the lighter renders for spread error by name, the others
-		 * by depth */
+		/* the lighter renders for spread error by their options, the
+		 * others by depth */
+		const struct accum_spread sp = accum_spread_render(edges, depth);
 		char how[32];
-		if (accum_spread_light_threshold(edges) > 0.0)
-			snprintf(how, sizeof(how), "%s",
-				 edges == ACC_AA_FOR_SPREAD_R3 ? "+A0.1 +R3" : "+A0.3 +R2");
+		if (accum_for_spread(edges) && sp.light)
+			snprintf(how, sizeof(how), "%s %s", sp.a, sp.r);
 		else
 			snprintf(how, sizeof(how), "depth %d", depth);
 		progress(r, "pass %d: the estimated error %s: %zu region%s by POV-Ray's "

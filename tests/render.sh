@@ -589,6 +589,13 @@ check "... resumed with --sampler scale, the run goes by it" \
 	-v --report "$T/tm.json" -- +WT1 2>"$T/tm.log" || bad "soft_shadows, target 0.5: render failed"
 check "... no pass, no choice: the report says auto" grep -q '"sampler_chosen": "auto"' "$T/tm.json"
 check "... and no line says otherwise" test "$(grep -c 'no scale 2' "$T/tm.log")" -eq 0
+# price LOG NAME: the price -v printed for the render level NAME of a pass
+# whose error is spread, and spend LOG what the pass may spend, on the last
+# such line (a pass that planned twice, its renders started early not
+# matching, prints two)
+price() { grep -o "[0-9.]*\( core-s\)\? at $2[,;]" "$1" | tail -n 1 | awk '{ print $1 }'; }
+spend() { sed -n 's/.*the pass may spend \([0-9.]*\)$/\1/p' "$1" | tail -n 1; }
+
 # spread_level SCENE TAG LOW HIGH MLOW MHIGH: the first refinement pass of SCENE at
 # 320x240 on one core, the cost of a sample pinned at 1e-6 s (spread error,
 # its scale-2 regions rendered by POV-Ray's +AM1 at twice the size), under
@@ -609,11 +616,6 @@ spread_level() {
 		--cost-sample 1e-6 --cost-job 0.05 -v --keep-workdir)
 	"${sp[@]}" -o "$T/$tag-30.exr" --budget 30 -- +WT1 2>"$T/$tag-30.log" ||
 		{ bad "$(basename "$scene") 320x240 --budget 30: render failed"; return 1; }
-	# price LOG NAME: the price -v printed for the level NAME, and spend LOG
-	# what the pass may spend, on the last such line (a pass that planned
-	# twice, its renders started early not matching, prints two)
-	price() { grep -o "[0-9.]*\( core-s\)\? at $2[,;]" "$1" | tail -n 1 | awk '{ print $1 }'; }
-	spend() { sed -n 's/.*the pass may spend \([0-9.]*\)$/\1/p' "$1" | tail -n 1; }
 	plo=$(price "$T/$tag-30.log" "$lo")
 	phi=$(price "$T/$tag-30.log" "$hi")
 	may=$(spend "$T/$tag-30.log")

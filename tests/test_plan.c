@@ -1125,7 +1125,8 @@ static void test_merge_aa_edges(void **state)
 		};
 		for (int li = 0; li < 2; li++) {
 			assert_true(accum_for_spread(light[li].edges));
-			assert_true(accum_spread_light_threshold(light[li].edges) == light[li].t);
+			const struct accum_spread sr = accum_spread_render(light[li].edges, depth);
+			assert_true(sr.light && sr.threshold == light[li].t);
 			make_acc(&spr, 5, 1, flat_value);
 			assert_int_equal(accum_merge_aa_region(&spr, &big, 0, ACC_AA, depth,
 								 light[li].edges, 0, 0, 4, 0, 1,
