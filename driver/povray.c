@@ -697,7 +697,8 @@ static int cmd_build(const struct pov_job *job, struct cmd *c, char *err, size_t
 
 	if (cmd_push(c, strdup(binary_name(job, &from_env))) || cmd_push(c, strdup("-D")) ||
 	    cmd_push(c, strdup("+FE")) || cmd_push(c, strdup("-GR")) ||
-	    cmd_push(c, strdup("-V")) || cmd_push(c, xprintf("+W%d", job->width)) ||
+	    cmd_push(c, strdup(job->progress ? "+V" : "-V")) ||
+	    cmd_push(c, xprintf("+W%d", job->width)) ||
 	    cmd_push(c, xprintf("+H%d", job->height)))
 		goto oom;
 	if (r && (cmd_push(c, xprintf("+SC%d", r->x0 + 1)) ||
@@ -1222,6 +1223,7 @@ void pov_result_release(struct pov_result *res)
 	if (!res)
 		return;
 	free(res->log);
+	free(res->progress);
 	memset(res, 0, sizeof(*res));
 }
 
@@ -1274,6 +1276,8 @@ struct pjob {
 	pid_t pid;
 	int fd;			/* read end of the child's stdout + stderr, or -1 */
 	double start, deadline, kill_at;
+	double finish_by;	/* past the pool's deadline, left to end until
+				 * then (opts->finish_s); 0: not */
 	int stop;		/* STOP_*: why the pool is stopping it */
 	int killed;		/* SIGKILL sent */
 	int accepted;		/* ready() accepted its output */
@@ -1284,6 +1288,16 @@ struct pjob {
 				 * for a while after its release, or -1 */
 	double released;	/* when its gate was opened */
 	struct buf log;
+	/* with the pool's opts->progress: the progress lines read so far
+	 * (struct pov_result's), and the tail of the output they were last
+	 * looked for in, for a line split across reads */
+	int want_progress;
+	struct pov_progress *prog;
+	size_t nprog, capprog;
+	long prog_total;
+	double prog_since;	/* when the last line kept was first read */
+	char carry[64];
+	size_t ncarry;
 };
 
 /* Move fd to 3 or above (so that dup2 onto 0, 1, 2 is a real copy). */
@@ -1422,19 +1436,88 @@ static int spawn(struct pjob *j, int devnull, double t0, struct pov_result *res)
 	j->log.len = 0;
 	if (j->log.p)
 		j->log.p[0] = '\0';
+	j->nprog = 0;
+	j->ncarry = 0;
+	j->finish_by = 0;
 	return 0;
+}
+
+/* The "Rendered N of M pixels" lines in what j's child wrote just now,
+ * chunk (n bytes), after what it wrote before past its last such line (a
+ * line split across reads), at time t (seconds after the attempt started):
+ * a count that falls (another phase's) starts again, one that does not
+ * rise is not taken twice, and of the lines read within PROGRESS_BATCH_S
+ * of the first of them only the last is kept, at its time (POV-Ray's frontend
+ * passes them on in batches, up to 38 blocks' at 640x480, at times split
+ * over two reads: the time between two batches is the later one's blocks',
+ * shared). */
+#define PROGRESS_BATCH_S 0.003
+static void note_progress(struct pjob *j, const char *chunk, size_t n, double t)
+{
+	static const char key[] = "Rendered ";
+	char data[sizeof(j->carry) + 8192 + 1];
+	size_t len = j->ncarry;
+
+	memcpy(data, j->carry, len);
+	if (n > sizeof(data) - 1 - len) {
+		chunk += n - (sizeof(data) - 1 - len);
+		n = sizeof(data) - 1 - len;
+	}
+	memcpy(data + len, chunk, n);
+	len += n;
+	data[len] = '\0';
+	size_t end = 0;
+	for (const char *p = strstr(data, key); p; p = strstr(p + 1, key)) {
+		long done, total;
+		int used = 0;
+
+		if (sscanf(p, "Rendered %ld of %ld pixels%n", &done, &total, &used) != 2 || !used)
+			continue;
+		end = (size_t)(p - data) + (size_t)used;
+		if (j->nprog && done < j->prog[j->nprog - 1].done)
+			j->nprog = 0;	/* a new run of lines */
+		if (j->nprog && done == j->prog[j->nprog - 1].done)
+			continue;	/* seen in the last tail */
+		if (j->nprog && t - j->prog_since < PROGRESS_BATCH_S) {
+			/* the read's last, or a batch split over reads */
+			j->prog[j->nprog - 1].t = t;
+			j->prog[j->nprog - 1].done = done;
+			j->prog_total = total;
+			continue;
+		}
+		if (j->nprog == j->capprog) {
+			size_t cap = j->capprog ? 2 * j->capprog : 256;
+			struct pov_progress *q = realloc(j->prog, cap * sizeof(*q));
+
+			if (!q)
+				break;	/* out of memory: no more lines */
+			j->prog = q;
+			j->capprog = cap;
+		}
+		j->prog_since = t;
+		j->prog[j->nprog].t = t;
+		j->prog[j->nprog++].done = done;
+		j->prog_total = total;
+	}
+	if (len - end > sizeof(j->carry))
+		end = len - sizeof(j->carry);
+	j->ncarry = len - end;
+	memcpy(j->carry, data + end, j->ncarry);
 }
 
 /* Read what the child has written; closes the pipe at end of file. */
 static void drain(struct pjob *j)
 {
 	char chunk[8192];
+	const double t = now_s() - j->start;	/* of all it reads now */
 
 	while (j->fd >= 0) {
 		ssize_t n = read(j->fd, chunk, sizeof(chunk));
 
 		if (n > 0) {
 			buf_add(&j->log, chunk, (size_t)n, POV_LOG_MAX);
+			if (j->want_progress)
+				note_progress(j, chunk, (size_t)n, t);
 			continue;
 		}
 		if (n < 0 && errno == EINTR)
@@ -1513,6 +1596,14 @@ static int finish(struct pjob *j, const struct pov_pool_opts *opts, double t0,
 	pov_stats_parse(j->log.p, &res->stats);
 	free(res->log);
 	res->log = j->log.p ? strdup(j->log.p) : NULL;
+	free(res->progress);
+	res->progress = NULL;
+	res->nprogress = 0;
+	if (j->nprog && (res->progress = malloc(j->nprog * sizeof(*res->progress)))) {
+		memcpy(res->progress, j->prog, j->nprog * sizeof(*res->progress));
+		res->nprogress = j->nprog;
+		res->progress_total = j->prog_total;
+	}
 	res->message[0] = '\0';
 
 	if (res->exit_status == 0 && !stat(j->cmd.povout, &st) && S_ISREG(st.st_mode)) {
@@ -1633,14 +1724,41 @@ static void pool_early(struct pool *p)
 	}
 }
 
+/* Whether running job j's progress lines say it will have rendered its
+ * pixels within s seconds of now, at its rate over its lines. */
+static int job_finishing(const struct pjob *j, double now, double s)
+{
+	if (j->nprog < 2 || j->prog_total <= 0)
+		return 0;
+	const struct pov_progress *a = &j->prog[0], *b = &j->prog[j->nprog - 1];
+	const long left = j->prog_total - b->done;
+	if (left <= 0)
+		return 1;
+	if (b->done <= a->done || !(b->t > a->t))
+		return 0;
+	const double rate = (double)(b->done - a->done) / (b->t - a->t);
+	return (now - j->start - b->t) + (double)left / rate <= s;
+}
+
 /* Start nothing more and stop the running jobs (why: STOP_CANCEL or
- * STOP_DEADLINE), SIGKILL after grace seconds. */
+ * STOP_DEADLINE), SIGKILL after grace seconds; at the deadline, those
+ * job_finishing() within half of opts->finish_s (the rest to write their
+ * image) are left finish_s first. */
 static void pool_stop(struct pool *p, int why, double grace)
 {
+	const double now = now_s(), fs = p->opts->finish_s;
 	p->stopping = why;
-	for (size_t i = 0; i < p->n; i++)
-		if (p->pj[i].state == J_RUNNING)
-			stop_job(&p->pj[i], why, now_s(), grace);
+	for (size_t i = 0; i < p->n; i++) {
+		struct pjob *j = &p->pj[i];
+
+		if (j->state != J_RUNNING)
+			continue;
+		if (why == STOP_DEADLINE && fs > 0.0 && j->stop == STOP_NONE &&
+		    job_finishing(j, now, 0.5 * fs))
+			j->finish_by = now + fs;
+		else
+			stop_job(j, why, now, grace);
+	}
 }
 
 static void job_final(struct pool *p, size_t i)
@@ -1744,6 +1862,8 @@ static void pool_wait(struct pool *p)
 			wait_s = j->deadline - now;
 		if (j->kill_at && !j->killed && j->kill_at - now < wait_s)
 			wait_s = j->kill_at - now;
+		if (j->stop == STOP_NONE && j->finish_by > 0 && j->finish_by - now < wait_s)
+			wait_s = j->finish_by - now;
 		if (j->gate >= 0) {
 			if (now - j->released > GATE_HOLD_S) {
 				close(j->gate);
@@ -1808,6 +1928,8 @@ static void pool_check(struct pool *p)
 		}
 		if (j->stop == STOP_NONE && p->opts->timeout_s > 0 && now >= j->deadline)
 			stop_job(j, STOP_TIMEOUT, now, p->opts->grace_s);
+		if (j->stop == STOP_NONE && j->finish_by > 0 && now >= j->finish_by)
+			stop_job(j, STOP_DEADLINE, now, 0.05);	/* as pool_run()'s */
 		if (j->kill_at && !j->killed && now >= j->kill_at) {
 			kill(-j->pid, SIGKILL);
 			j->killed = 1;
@@ -1867,6 +1989,7 @@ double pov_prelaunch_end(struct pov_prelaunch *pre)
 		cmd_release(&pre->pj[k].cmd);
 		free(pre->pj[k].bin);
 		free(pre->pj[k].log.p);
+		free(pre->pj[k].prog);
 	}
 	double cpu = pre->cpu_s;
 	free(pre->pj);
@@ -1990,6 +2113,7 @@ static void prelaunch_take(struct pool *p, struct pov_prelaunch *pre)
 			pre->pj[k].fd = -1;
 			pre->pj[k].gate = -1;
 			j->state = J_RUNNING;
+			j->want_progress = p->opts->progress;
 			gate_replace(pre->gate[k]);
 			p->res[i].prelaunched = 1;
 			pre->taken++;
@@ -2045,6 +2169,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 	for (size_t i = 0; i < njobs; i++) {
 		p.pj[i].fd = -1;
 		p.pj[i].gate = -1;
+		p.pj[i].want_progress = opts->progress;
 	}
 	/* Everything that can be checked is checked before anything starts. */
 	for (size_t i = 0; i < njobs; i++) {
@@ -2161,6 +2286,7 @@ out:
 			cmd_release(&p.pj[i].cmd);
 			free(p.pj[i].bin);
 			free(p.pj[i].log.p);
+			free(p.pj[i].prog);
 		}
 	}
 	free(p.pj);

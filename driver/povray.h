@@ -106,6 +106,10 @@ struct pov_job {
 		POV_RAD_LOAD,		/* +RFI: start from the file's samples */
 	} radiosity_mode;		/* with radiosity; POV-Ray ignores both
 					 * options when the scene has none */
+	int progress;			/* +V rather than -V: POV-Ray prints a
+					 * "Rendered N of M pixels" line as each
+					 * block ends (struct pov_result's
+					 * progress, with the pool's) */
 };
 
 /* What POV-Ray's statistics report about one run. */
@@ -238,6 +242,19 @@ struct pov_result {
 	int prelaunched;		/* its first attempt was taken from
 					 * opts->prelaunched: wall_s and start_s
 					 * count from its release */
+	/* With opts->progress: POV-Ray's "Rendered N of M pixels" lines of
+	 * the last attempt as they were read, each when (seconds after the
+	 * attempt started) and N, the last rising run of them (a count that
+	 * falls starts again); owned, NULL when none */
+	struct pov_progress *progress;
+	size_t nprogress;
+	long progress_total;		/* their M */
+};
+
+/* One "Rendered N of M pixels" line of a render: when it was read, and N. */
+struct pov_progress {
+	double t;
+	long done;
 };
 
 /* Free what res owns and zero it; a zeroed result is a no-op. */
@@ -279,6 +296,15 @@ struct pov_pool_opts {
 	 * pov_prelaunch_start()); the rest of the set is stopped before any
 	 * job starts.  The set is spent: end it with pov_prelaunch_end(). */
 	struct pov_prelaunch *prelaunched;
+	/* If set: each result's progress (POV-Ray's progress lines, timed
+	 * as read; see struct pov_result). */
+	int progress;
+	/* If > 0, with progress: at deadline_s, a running job whose progress
+	 * lines say it will have rendered its pixels within half of finish_s
+	 * (those left at its rate so far; the last line's count its whole:
+	 * done rendering, writing its image) is left finish_s to end before
+	 * it is stopped, rather than lost with its work all but done. */
+	double finish_s;
 };
 
 /* Defaults: max_jobs from pov_pool_size() for one job per core, no

@@ -90,7 +90,9 @@ static const char usage_options[] =
 	"                        (default: 60 + 10 x the dearest region's predicted cost)\n"
 	"  --cost-job S          the planner's cost of one POV-Ray run, seconds, and\n"
 	"  --cost-sample S       of one sample (default: measured on the base pass and\n"
-	"                        rounded to powers of two; the report has them)\n"
+	"                        rounded to powers of two; the report has them; given,\n"
+	"                        a budget's cost map starts at 1, not at the base\n"
+	"                        pass's progress)\n"
 	"  --radiosity-scale K   if the scene has radiosity, re-render the whole frame\n"
 	"                        at K x the size on one thread for the radiosity\n"
 	"                        solution and keep its K x K samples per pixel (1, 2, 4\n"
@@ -107,7 +109,8 @@ static const char usage_options[] =
 	"  --error-map FILE      error map EXR (default OUT.errors.exr): error,\n"
 	"                        relerror, samples, order, bandwidth, pass, scales,\n"
 	"                        fit (the share of the regression's fit OUT.exr\n"
-	"                        holds)\n"
+	"                        holds), cost (a sample's cost there over the\n"
+	"                        frame's mean, under a budget; else 1)\n"
 	"  --report FILE         JSON report of every pass (default: none)\n";
 static const char usage_options2[] =
 	"  --sampler S           how pixels get their samples: auto (default: grid for\n"
@@ -688,6 +691,7 @@ static int write_error_map(struct run *r, const struct lpr_result *res, char *er
 {
 	static const char *const names[] = {
 		"error", "relerror", "samples", "order", "bandwidth", "pass", "scales", "fit",
+		"cost",
 	};
 	enum { NCH = sizeof names / sizeof names[0] };
 	struct image m = {0};
@@ -706,6 +710,7 @@ static int write_error_map(struct run *r, const struct lpr_result *res, char *er
 		q[5] = o[ACC_PASS];
 		q[6] = o[ACC_SCALES];
 		q[7] = r->take[i];
+		q[8] = r->cost_map ? r->cost_map[i] : 1.0f;
 	}
 	int rc = image_write_exr(r->error_map, &m, err, errlen);
 	image_release(&m);
@@ -831,6 +836,11 @@ static int rad_prelaunched(const struct run *r, int k)
 
 static const struct pov_define pass0 = { "POVPRESS_PASS", "0" };
 
+/* POV-Ray's blocks' side (its default +BS), and the fewest reads of the
+ * base pass's progress lines a cost map is made from (base_cost_map()) */
+#define POV_BLOCK 32
+#define MAP_MIN_READS 16
+
 /* whole_frame()'s job; extra has room for r->nextra + 1. */
 static void frame_job(const struct run *r, int k, int threads, const char *out,
 		      const char *radfile, struct pov_job *job, const char **extra)
@@ -864,6 +874,13 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
 	}
 	struct pov_job job;
 	frame_job(r, k, threads, out, radfile, &job, extra);
+	/* the base pass's progress lines, for base_cost_map(), where the
+	 * frame has blocks enough for MAP_MIN_READS reads of them (at
+	 * 160x120, 20 blocks, glossy_reflection's came in 8 to 10 reads);
+	 * elsewhere they would only cost POV-Ray's frontend their printing */
+	job.progress = r->cost_map != NULL && k == 1 && !strcmp(what, "base pass") &&
+		       (long)((r->w + POV_BLOCK - 1) / POV_BLOCK) * ((r->h + POV_BLOCK - 1) / POV_BLOCK) >=
+			       4 * MAP_MIN_READS;
 	struct pov_pool_opts po;
 	pov_pool_opts_init(&po);
 	po.max_jobs = 1;
@@ -873,6 +890,7 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
 	po.prelaunched = rad_prelaunched(r, k) ? r->pre : NULL;
 	po.timeout_s = r->timeout > 0 ? r->timeout : 0.0;
 	po.deadline_s = deadline;
+	po.progress = job.progress;
 	double written = 0.0;
 	po.ready = note_written;
 	po.ready_log = stats_printed;
@@ -1284,6 +1302,7 @@ static void prelaunch_start(struct run *r, int pass, const struct pre_kind *kind
 			g->edges = kinds[t].edges;
 			plan_output_name(outs[n], sizeof outs[n], r->workdir, pass, n, g->scale);
 			plan_job(&base, g, outs[n], &regs[n], extras + n * (r->nextra + 4), &jobs[n]);
+			jobs[n].progress = r->budget > 0.0;	/* as refine_pass()'s */
 			n++;
 		}
 	}
@@ -1462,6 +1481,127 @@ static size_t prelaunch_cover(struct run *r, int pass, struct plan *pl, size_t *
 	return m;
 }
 
+/*
+ * Under a budget, the cost map's start (1 everywhere until now, the base
+ * pass being one render) from the base pass's progress lines: POV-Ray
+ * renders a frame in blocks of POV_BLOCK x POV_BLOCK pixels handed to its
+ * threads row by row from the top, and prints "Rendered N of M pixels" as
+ * each ends; its frontend passes the lines on in batches, and the pool
+ * keeps each read's count and time (res->progress).  A block's cost is the
+ * time the count took to pass over its pixels (interpolated between the
+ * reads), smoothed over BLOCK_SMOOTH blocks either side in that order (a
+ * block ends out of order by up to the threads' count), over the frame's
+ * mean; the blocks before the first read take the first measured one's.
+ * Where the user's options set the blocks' size or order (+BS, +RP), the
+ * reads' steps are not mostly whole blocks, there are fewer than
+ * MAP_MIN_READS reads (glossy_reflection at 160x120: 10, at 320x240 50),
+ * or the cost of a sample is the user's (--cost-sample: a plan that timing
+ * does not move), the map stays 1.  Debian's textures/finishes/var_refl at
+ * 640x480 (`povray +W640 +H480 -A +WT2 +V`, its lines timed as read): the
+ * upper half's 153,600 pixels in 0.04 s, the lower half's in 0.15 s; at
+ * twice the size on one thread (+SR/+ER halves) 0.38 and 1.16 CPU s.  The
+ * map priced both halves at the mean, and pass 1's renders of the lower
+ * half ran into the deadline.
+ */
+#define BLOCK_SMOOTH 2
+#define COST_MIN 0.02
+#define COST_MAX 50.0
+static int base_cost_map(struct run *r, const struct pov_result *res)
+{
+	const struct pov_progress *pg = res->progress;
+	const size_t np = res->nprogress;
+	const long all = (long)r->w * r->h;
+	if (!r->cost_map || r->user_cost_sample > 0.0 || np < MAP_MIN_READS ||
+	    res->progress_total != all)
+		return 0;
+	/* the blocks' size and order are POV-Ray's defaults: not the user's
+	 * (+BS, +RP), and the lines' steps whole blocks (full ones, or with
+	 * a last column's or row's) */
+	for (size_t k = 0; k < r->nextra; k++) {
+		const char *o = r->extra[k];
+		if ((o[0] == '+' || o[0] == '-') && (!strncasecmp(o + 1, "BS", 2) ||
+						     !strncasecmp(o + 1, "RP", 2)))
+			return 0;
+		if (!strncasecmp(o, "Render_Block", 12) || !strncasecmp(o, "Render_Pattern", 14))
+			return 0;
+	}
+	long full = 0;
+	for (size_t i = 1; i < np; i++)
+		if ((pg[i].done - pg[i - 1].done) % ((long)POV_BLOCK * POV_BLOCK) == 0)
+			full++;
+	if (full < (long)(np / 2))
+		return 0;
+	const int bw = (r->w + POV_BLOCK - 1) / POV_BLOCK, bh = (r->h + POV_BLOCK - 1) / POV_BLOCK;
+	const int nb = bw * bh;
+	double *rate = calloc((size_t)nb, sizeof(*rate)), *sm = calloc((size_t)nb, sizeof(*sm));
+	long *npx = calloc((size_t)nb, sizeof(*npx));
+	if (!rate || !sm || !npx) {
+		free(rate);
+		free(sm);
+		free(npx);
+		return 0;
+	}
+	/* the time at which the count passed p: the lines interpolated,
+	 * before the first line the first's */
+	size_t at = 0;
+	long before = 0;
+	int first = -1;
+	for (int b = 0; b < nb; b++) {
+		const int bx = b % bw, by = b / bw;
+		const int wx = (bx + 1) * POV_BLOCK > r->w ? r->w - bx * POV_BLOCK : POV_BLOCK;
+		const int wy = (by + 1) * POV_BLOCK > r->h ? r->h - by * POV_BLOCK : POV_BLOCK;
+		npx[b] = (long)wx * wy;
+		const long p0 = before, p1 = before + npx[b];
+		before = p1;
+		if (p0 < pg[0].done)
+			continue;	/* before the first line */
+		double tt[2];
+		const long pp[2] = { p0, p1 };
+		for (int e = 0; e < 2; e++) {
+			while (at + 1 < np && pg[at + 1].done < pp[e])
+				at++;
+			if (at + 1 >= np) {
+				tt[e] = pg[np - 1].t;
+			} else {
+				const double f = (double)(pp[e] - pg[at].done) /
+						 (double)(pg[at + 1].done - pg[at].done);
+				tt[e] = pg[at].t + (f < 0.0 ? 0.0 : f > 1.0 ? 1.0 : f) *
+							   (pg[at + 1].t - pg[at].t);
+			}
+		}
+		rate[b] = (tt[1] - tt[0]) / (double)npx[b];
+		if (first < 0)
+			first = b;
+	}
+	double sum = 0.0;
+	if (first >= 0) {
+		for (int b = 0; b < first; b++)
+			rate[b] = rate[first];
+		for (int b = 0; b < nb; b++) {
+			double s = 0.0, wsum = 0.0;
+			for (int d = -BLOCK_SMOOTH; d <= BLOCK_SMOOTH; d++)
+				if (b + d >= 0 && b + d < nb) {
+					s += rate[b + d] * (double)npx[b + d];
+					wsum += (double)npx[b + d];
+				}
+			sm[b] = s / wsum;
+			sum += sm[b] * (double)npx[b];
+		}
+	}
+	const double mean = sum / (double)all;
+	const int ok = first >= 0 && mean > 0.0;
+	for (int y = 0; ok && y < r->h; y++)
+		for (int x = 0; x < r->w; x++) {
+			const double v = sm[(y / POV_BLOCK) * bw + x / POV_BLOCK] / mean;
+			r->cost_map[(size_t)y * r->w + x] =
+				(float)(v < COST_MIN ? COST_MIN : v > COST_MAX ? COST_MAX : v);
+		}
+	free(rate);
+	free(sm);
+	free(npx);
+	return ok;
+}
+
 /* The base pass: the whole image, one sample per pixel. */
 static int base_pass(struct run *r, char *err, size_t errlen)
 {
@@ -1506,6 +1646,16 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 				    (double)(st->pixels + st->samples) :
 				    (double)r->w * r->h;
 	r->cost_sample = trace / rays;
+	if (base_cost_map(r, &res) && r->verbose) {
+		float lo = INFINITY, hi = 0.0f;
+		for (size_t i = 0; i < (size_t)r->w * r->h; i++) {
+			lo = r->cost_map[i] < lo ? r->cost_map[i] : lo;
+			hi = r->cost_map[i] > hi ? r->cost_map[i] : hi;
+		}
+		progress(r, "base pass: a sample's cost from its progress lines (over %.2f s), "
+			 "%.2g to %.2g times the frame's mean",
+			 res.progress[res.nprogress - 1].t - res.progress[0].t, lo, hi);
+	}
 	/* the pretrace, which the radiosity pass repeats on one thread */
 	r->pretrace_s = (st->have & POV_HAVE_RADIOSITY) ? st->radiosity.cpu_s : 0.0;
 	r->rad_rays = (st->have & POV_HAVE_RADIOSITY) && (st->have & POV_HAVE_RAD_RAYS) ?
@@ -1800,6 +1950,20 @@ static void back_to_scale2(struct plan_region *g)
 	g->depth = 0;
 }
 
+/* pl's antialiased regions after the others, each part in its order: they
+ * are folded last (choose_samplers()). */
+static void aa_last(struct plan *pl)
+{
+	size_t m = 0;
+	for (size_t k = 0; k < pl->nregions; k++) {
+		struct plan_region g = pl->regions[k];
+		if (g.scale == ACC_AA)
+			continue;
+		memmove(pl->regions + m + 1, pl->regions + m, (k - m) * sizeof(g));
+		pl->regions[m++] = g;
+	}
+}
+
 /* aa_depth() where +R3 over all of a plan's antialiased regions does not
  * fit: the regions whose +R3 costs (c3, by region, from aa_depth(); NULL
  * when it ran out of memory: none) least more than their scale 2 keep it
@@ -1927,8 +2091,9 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
  * threshold (soft_shadows at 640x480: 5.1 CPU s for 281,600 pixels, 85,840
  * of them such, at 0.87 microseconds a sample, 55 a pixel at +R4); the pass is
  * planned as scale 2, so under a budget the renders are taken at the
- * first of spread_levels (+R4, +A0.1 +R3, +R2 or +A0.3 +R2) where its margin
- * times that cost fits what the pass may spend, priced at
+ * first of spread_levels (+R4, +A0.1 +R3, +R2 or +A0.3 +R2) where
+ * SPREAD_MARGIN times that cost fits what the pass may spend (and the
+ * level above it where that fits too: spread_mix()), priced at
  * the base pass's measured cost of a sample, not the plan's power of two
  * (soft_shadows' 0.87 microseconds went at times to 0.48, the +R2 renders
  * took twice their price, and three of seven were lost at the deadline of
@@ -1945,36 +2110,46 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
 #define SPREAD_SAMPLE_S 1.5e-6
 #define SPREAD_MARGIN 1.25
 /*
- * The lighter levels' margin.  Their price missed their CPU as the
- * others' does: over soft_shadows, thin_geometry and Debian's var_refl,
- * noise_generator, swirlbox and granite at 640x480 (`--budget 40 --target
- * 1e-6 --max-passes 1`, each level forced by a scratch switch, 2026-12-05
- * 02:40 UTC) the pass's POV-Ray CPU was 0.85 to 1.41 times the price at
- * every level, median 1.17, thin_geometry and var_refl 1.26 to 1.41.  At
- * SPREAD_MARGIN thin_geometry under --budget 2 took +A0.1 +R3 priced at
- * 1.7 core-s of 2.2, and in two runs of three one of its four renders was
- * stopped at the deadline (relMSE 4.8e-3 to 5.7e-3, against 5.7e-4 by
- * +R2 and 2.5e-4 by +A0.1 +R3 whole).
+ * The margin's measure.  The price missed the pass's CPU at every level:
+ * over soft_shadows, thin_geometry and Debian's var_refl, noise_generator,
+ * swirlbox and granite at 640x480 (`--budget 40 --target 1e-6
+ * --max-passes 1`, each level forced by a scratch switch, 2026-12-05 02:40
+ * UTC) the pass's POV-Ray CPU was 0.85 to 1.41 times the price, median
+ * 1.17, thin_geometry and var_refl 1.26 to 1.41, and the lighter levels
+ * took a margin of 1.4: at 1.25 thin_geometry under --budget 2 took +A0.1
+ * +R3 priced at 1.7 core-s of 2.2, and in two runs of three one of its
+ * four renders was stopped at the deadline (relMSE 4.8e-3 to 5.7e-3,
+ * against 5.7e-4 by +R2).  Priced by the base pass's cost map
+ * (base_cost_map()), the same runs on the seven scenes (granite too,
+ * 03:57 to 04:02 UTC) took 0.83 to 1.25 times the price (median 1.12;
+ * without the map, the same build, 0.87 to 1.43), so every level takes
+ * SPREAD_MARGIN.
  */
-#define SPREAD_MARGIN_LIGHT 1.4
 /*
  * The renders a pass's scale-2 regions may become, in the order tried:
  * +A0.03 +R4 (ACC_AA_SPREAD_DEPTH), then under a budget that it does not
  * fit the lighter +A0.1 +R3 (ACC_AA_FOR_SPREAD_R3, accum.h), +A0.03 +R2
  * and +A0.3 +R2 (ACC_AA_FOR_SPREAD_FLOOR), each as its edges and depth
- * (accum_spread_render() has its threshold and cells) with the margin its
- * price is taken with.
+ * (accum_spread_render() has its threshold and cells).
  */
 static const struct spread_level {
 	int edges, depth;
-	double margin;
 } spread_levels[] = {
-	{ ACC_AA_FOR_SPREAD, ACC_AA_SPREAD_DEPTH, SPREAD_MARGIN },
-	{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_DEPTH, SPREAD_MARGIN_LIGHT },
-	{ ACC_AA_FOR_SPREAD, 2, SPREAD_MARGIN },
-	{ ACC_AA_FOR_SPREAD_FLOOR, 2, SPREAD_MARGIN_LIGHT },
+	{ ACC_AA_FOR_SPREAD, ACC_AA_SPREAD_DEPTH },
+	{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_DEPTH },
+	{ ACC_AA_FOR_SPREAD, 2 },
+	{ ACC_AA_FOR_SPREAD_FLOOR, 2 },
 };
 enum { NSPREAD = sizeof spread_levels / sizeof spread_levels[0] };
+/* The place in spread_levels of the render of edges and depth (NSPREAD
+ * where none). */
+static int spread_rank(int edges, int depth)
+{
+	int l = 0;
+	while (l < NSPREAD && !(spread_levels[l].edges == edges && spread_levels[l].depth == depth))
+		l++;
+	return l;
+}
 /*
  * Below the first level a render is taken only where the pass so spends at
  * least this share of what it may.  Where it would spend less, passes follow it, and
@@ -1987,6 +2162,111 @@ enum { NSPREAD = sizeof spread_levels / sizeof spread_levels[0] };
  * to 0.78, erred 0.23 to 0.57 times as much.
  */
 #define SPREAD_R2_SHARE 0.4
+
+/* Region k's margined price at level l of spread_levels (NSPREAD: the
+ * scale 2 it was planned as; a region of another scale as planned), price
+ * as spread_am1()'s. */
+static double level_cost(const struct plan *pl, const double *price, size_t k, int l)
+{
+	if (pl->regions[k].scale != 2 || l >= NSPREAD)
+		return SPREAD_MARGIN * pl->regions[k].cost;
+	return SPREAD_MARGIN * price[k * NSPREAD + l];
+}
+
+/* The wall seconds pl's renders take on `slots` jobs at once, each
+ * started in its order (the antialiased ones last: aa_last()) as a job
+ * ends, region k taking level_cost() at level t, or t - 1 where up[k],
+ * and lat (POV-Ray's start). */
+static double mix_makespan(const struct plan *pl, const double *price, int t,
+			   const unsigned char *up, int slots, double lat)
+{
+	double end[64] = { 0.0 }, last = 0.0;
+	slots = slots < 1 ? 1 : slots > 64 ? 64 : slots;
+	for (int part = 0; part < 2; part++)
+		for (size_t k = 0; k < pl->nregions; k++) {
+			const int l = up[k] ? t - 1 : t;
+			const int aa = pl->regions[k].scale == 2 && l < NSPREAD;
+			if (aa != part)
+				continue;
+			int s = 0;
+			for (int j = 1; j < slots; j++)
+				s = end[j] < end[s] ? j : s;
+			end[s] += lat + level_cost(pl, price, k, l);
+			last = end[s] > last ? end[s] : last;
+		}
+	return last;
+}
+
+/*
+ * Where a pass's scale-2 regions fit level t of spread_levels whole (or
+ * NSPREAD: none, they stay at scale 2) but not level t - 1, the regions
+ * whose move up to t - 1 gains most of the plan's predicted gain a
+ * core-second more of margined price take it (up[k] set), in that order,
+ * while the pass fits what it may spend and its renders, each at its
+ * margined price and POV-Ray's start lat, end within MIX_SLACK of `left`
+ * less MIX_SPARE_S on `slots` jobs at once (mix_makespan(): a dear render
+ * started last can outlast the others).  The mixed pass fills the budget
+ * where the whole level left a step of it spare, and a render stopped at
+ * the deadline loses all it did: without the slack and spare, under
+ * --budget 2 at 640x480 one run in three of soft_shadows, thin_geometry
+ * and noise_generator and every run of var_refl lost one or two renders
+ * (relMSE 1.2e-3 to 7.8e-3 against 7.5e-5 to 2.1e-3 for the others;
+ * 2026-12-05 03:32 to 03:41 UTC).  No region moves up to the first level,
+ * +A0.03 +R4, whose 64 cells at each edge pixel make a region's price the
+ * least sure: soft_shadows under --budget 3 took it on two of four
+ * regions beside +A0.1 +R3 and lost one of them, 48% done, at the
+ * deadline in four runs of six (relMSE 1.4e-3 to 1.6e-3, against 1.2e-4
+ * with +A0.1 +R3 whole; 04:35 to 04:50 UTC).
+ * Each level lies a step of the budget from the next (their prices 1.3 to
+ * 2 times apart), and the first pass took it whole or not at all: swirlbox
+ * (Debian's advanced/swirlbox) at 640x480 under --budget 2 priced +A0.3
+ * +R2 at 1.79 core-s where the pass may spend 2.17, and rendered its four
+ * regions at scale 2.
+ */
+struct mix_cand {
+	size_t k;
+	double more, score;
+};
+static int by_score_desc(const void *a, const void *b)
+{
+	const double x = ((const struct mix_cand *)a)->score,
+		     y = ((const struct mix_cand *)b)->score;
+	return (x < y) - (x > y);
+}
+#define MIX_SLACK 0.85
+#define MIX_SPARE_S 0.1
+static void spread_mix(const struct plan *pl, const struct plan_params *pp, double left,
+		       int slots, double lat, const double *price, const double sums[NSPREAD],
+		       int t, unsigned char *up)
+{
+	struct mix_cand *c = malloc(pl->nregions * sizeof(*c));
+	if (!c)
+		return;	/* out of memory: level t whole */
+	size_t nc = 0;
+	for (size_t k = 0; k < pl->nregions; k++) {
+		const struct plan_region *g = &pl->regions[k];
+		if (g->scale != 2)
+			continue;
+		const double more = level_cost(pl, price, k, t - 1) - level_cost(pl, price, k, t);
+		c[nc].k = k;
+		c[nc].more = more;
+		c[nc].score = more > 0.0 ? g->gain / more : INFINITY;
+		nc++;
+	}
+	qsort(c, nc, sizeof(*c), by_score_desc);
+	double total = SPREAD_MARGIN * (t < NSPREAD ? sums[t] : pl->cost);
+	for (size_t i = 0; i < nc; i++) {
+		if (!(total + c[i].more <= pp->budget))
+			continue;
+		up[c[i].k] = 1;
+		if (mix_makespan(pl, price, t, up, slots, lat) <= MIX_SLACK * left - MIX_SPARE_S)
+			total += c[i].more;
+		else
+			up[c[i].k] = 0;
+	}
+	free(c);
+}
+
 static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan_params *pp,
 			 double left, int *sparse, double sums[NSPREAD])
 {
@@ -2025,29 +2305,42 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 			worst[t] = c > worst[t] ? c : worst[t];
 		}
 	}
-	int t = 0;
+	int t = 0, mix = 0;
 	if (r->budget > 0.0) {
 		while (t < NSPREAD &&
-		       !fits(spread_levels[t].margin, sums[t], worst[t], pp, left))
+		       !fits(SPREAD_MARGIN, sums[t], worst[t], pp, left))
 			t++;
-		if (t > 0 && t < NSPREAD && !(sums[t] >= SPREAD_R2_SHARE * pp->budget))
+		mix = t > 1;	/* not up to +R4: see spread_mix() */
+		if (t > 0 && t < NSPREAD && !(sums[t] >= SPREAD_R2_SHARE * pp->budget)) {
 			t = NSPREAD;	/* see SPREAD_R2_SHARE */
+			mix = 0;
+		}
 	}
+	/* each scale-2 region's level: t, or t - 1 where spread_mix() so
+	 * chose */
+	unsigned char *up = mix ? calloc(pl->nregions, 1) : NULL;
+	if (up)
+		spread_mix(pl, pp, left, r->jobs < (int)pl->nregions ? r->jobs : (int)pl->nregions,
+			   r->latency, price, sums, t, up);
 	size_t n = 0;
-	for (size_t k = 0; k < pl->nregions && t < NSPREAD; k++) {
+	for (size_t k = 0; k < pl->nregions; k++) {
 		struct plan_region *g = &pl->regions[k];
-		if (g->scale != 2)
+		const int l = up && up[k] ? t - 1 : t;
+		if (g->scale != 2 || l >= NSPREAD)
 			continue;
 		g->scale = ACC_AA;
 		g->frame = ACC_GRID_FRAME;
-		g->edges = spread_levels[t].edges;
-		g->depth = spread_levels[t].depth;
+		g->edges = spread_levels[l].edges;
+		g->depth = spread_levels[l].depth;
 		/* its price, for the progress display's guess and the
 		 * renders' timeout */
-		pl->cost += price[k * NSPREAD + t] - g->cost;
-		g->cost = price[k * NSPREAD + t];
+		pl->cost += price[k * NSPREAD + l] - g->cost;
+		g->cost = price[k * NSPREAD + l];
 		n++;
 	}
+	if (up && t == NSPREAD && n)
+		aa_last(pl);
+	free(up);
 	free(price);
 	return n;
 }
@@ -2151,8 +2444,6 @@ static double final_reserve(const struct run *r)
  */
 #define LEARN_MAX 8.0
 #define LEARN_MIN 0.02
-#define COST_MIN 0.02
-#define COST_MAX 50.0
 static void learn_costs(struct run *r, const struct plan_params *pp, const struct plan *pl,
 			const struct pov_result *res)
 {
@@ -2260,6 +2551,57 @@ static double edge_target(const struct run *r, int *sparse)
 }
 
 /*
+ * The progress line of a pass's naa antialiased renders in scale 2's
+ * place (pl's regions of scale ACC_AA and frame ACC_GRID_FRAME): why, and
+ * how, the lighter renders for spread error by their options, the others
+ * by depth; where spread_mix() gave the regions two levels, each with its
+ * count, the lighter first.
+ */
+static void aa_progress(struct run *r, int pass, const struct plan *pl, size_t naa)
+{
+	struct { int edges, depth; size_t n; } lv[2] = { { 0, 0, 0 }, { 0, 0, 0 } };
+	int nl = 0;
+	for (size_t k = 0; k < pl->nregions; k++) {
+		const struct plan_region *g = &pl->regions[k];
+		if (g->scale != ACC_AA || g->frame != ACC_GRID_FRAME)
+			continue;
+		int l = 0;
+		while (l < nl && !(lv[l].edges == g->edges && lv[l].depth == g->depth))
+			l++;
+		if (l == nl && nl < 2) {
+			lv[nl].edges = g->edges;
+			lv[nl].depth = g->depth;
+			nl++;
+		}
+		if (l < nl)
+			lv[l].n++;
+	}
+	char how[2][32], all[96];
+	for (int l = 0; l < nl; l++) {
+		const struct accum_spread sp = accum_spread_render(lv[l].edges, lv[l].depth);
+		if (accum_for_spread(lv[l].edges) && (sp.light || nl > 1))
+			snprintf(how[l], sizeof(how[l]), "%s %s", sp.a, sp.r);
+		else
+			snprintf(how[l], sizeof(how[l]), "depth %d", lv[l].depth);
+	}
+	if (nl > 1) {
+		/* the lighter level is the later one in spread_levels */
+		const int a = spread_rank(lv[0].edges, lv[0].depth) <
+			      spread_rank(lv[1].edges, lv[1].depth);
+		snprintf(all, sizeof(all), "%zu at %s and %zu at %s", lv[a].n, how[a],
+			 lv[!a].n, how[!a]);
+	} else {
+		snprintf(all, sizeof(all), "%s", nl ? how[0] : "");
+	}
+	const int edges = nl ? lv[0].edges : 0;
+	progress(r, "pass %d: the estimated error %s: %zu region%s by POV-Ray's "
+		 "antialiasing (+AM%d) in place of scale 2, %s", pass,
+		 accum_for_spread(edges) ? "is spread and samples are cheap"
+		 : edges ? "sits at edges" : "sits in few pixels",
+		 naa, naa == 1 ? "" : "s", accum_for_spread(edges) ? 1 : 2, all);
+}
+
+/*
  * One refinement pass from the error estimate r->est.  Returns 0 when a
  * pass ran, PASS_STOP when the planner stopped the run (r->stop says why),
  * -1 on failure, POV_INTERRUPTED when a signal came.
@@ -2275,6 +2617,21 @@ enum { PASS_STOP = 2 };
  * to 8.06 s. */
 #define FRAME_COST 1e-7
 #define MIN_PASS_GAIN 0.01
+/*
+ * How long past its deadline a pass's region render that will have
+ * rendered its pixels by then is left to end (pov_pool_opts' finish_s),
+ * at most FINISH_SHARE of the budget.  Stopped at the deadline, a render
+ * loses all it did: Debian's textures/finishes/var_refl at 640x480 under
+ * --budget 2, one run in four, lost a render of 1.0 core-s that had
+ * rendered all its pixels and was writing its image (its progress lines,
+ * 2026-12-05): relMSE 9.0e-3, the others 2.6e-3 to 2.8e-3.  POV-Ray
+ * wrote the image of a region render at 1280x960 and exited 0.06 to 0.32 s
+ * after its last progress line (var_refl's lower half at +AM1 +A0.3 +R2,
+ * swirlbox's upper half without antialiasing, two runs each, with
+ * povwait.so); the pool takes the image as it is closed, before the exit.
+ */
+#define FINISH_S 0.3
+#define FINISH_SHARE 0.075
 static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 {
 	double t = now_s(), c = self_cpu();
@@ -2407,6 +2764,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		}
 		plan_job(&base, &pl.regions[k], outs[k], &regs[k], extras + k * (r->nextra + 4),
 			 &jobs[k]);
+		/* under a budget, how far a render stopped at its end got */
+		jobs[k].progress = r->budget > 0.0;
 	}
 	/* what this pass renders, for inspection and for running elsewhere */
 	if (plan_regions_save(wpath(r, "regions.tsv"), &pl, pass, outs, err, errlen))
@@ -2414,6 +2773,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	struct pov_pool_opts po;
 	pov_pool_opts_init(&po);
 	po.max_jobs = r->jobs < (int)n ? r->jobs : (int)n;
+	po.progress = r->budget > 0.0;
 	po.timeout_s = r->timeout;
 	if (po.timeout_s <= 0.0) {
 		/* a minute plus ten times what the dearest region should cost:
@@ -2448,8 +2808,12 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		 * of glossy floor costs more per sample than the frame's
 		 * average: glossy_reflection at --budget 8 ended at 10.9 s):
 		 * regions still rendering when only the analysis's time is
-		 * left are stopped, and what they did is lost */
+		 * left are stopped, and what they did is lost; but those
+		 * that will have rendered their pixels within half of FINISH_S
+		 * (of FINISH_SHARE of the budget at most) are left that long */
 		po.deadline_s = deadline_in(r, reserve);
+		po.finish_s = FINISH_S < FINISH_SHARE * r->budget ? FINISH_S
+								 : FINISH_SHARE * r->budget;
 	}
 	r->pool_done = 0;
 	r->pool_total = (int)n;
@@ -2460,26 +2824,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	double cpu_wall = (pl.cost - (double)n * r->cost_job) / (n < (size_t)r->cores ? (double)n :
 								    r->cores);
 	double guess = rounds * r->latency > cpu_wall ? rounds * r->latency : cpu_wall;
-	int depth = 0, edges = 0;
-	for (size_t k = 0; k < n; k++) {
-		depth = pl.regions[k].depth > depth ? pl.regions[k].depth : depth;
-		edges = pl.regions[k].edges > edges ? pl.regions[k].edges : edges;
-	}
-	if (naa) {
-		/* the lighter renders for spread error by their options, the
-		 * others by depth */
-		const struct accum_spread sp = accum_spread_render(edges, depth);
-		char how[32];
-		if (accum_for_spread(edges) && sp.light)
-			snprintf(how, sizeof(how), "%s %s", sp.a, sp.r);
-		else
-			snprintf(how, sizeof(how), "depth %d", depth);
-		progress(r, "pass %d: the estimated error %s: %zu region%s by POV-Ray's "
-			 "antialiasing (+AM%d) in place of scale 2, %s", pass,
-			 accum_for_spread(edges) ? "is spread and samples are cheap"
-			 : edges ? "sits at edges" : "sits in few pixels",
-			 naa, naa == 1 ? "" : "s", accum_for_spread(edges) ? 1 : 2, how);
-	}
+	if (naa)
+		aa_progress(r, pass, &pl, naa);
 	progress(r, "pass %d: %zu region%s, %ld pixels (%ld chosen), %.0f samples, about %.1f s",
 		 pass, n, n == 1 ? "" : "s", pl.pixels, pl.chosen_pixels, pl.samples,
 		 guess + r->latency);
@@ -2493,14 +2839,26 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		goto out;
 	p.pass = pass;
 	int stopped = 0;
+	char how_far[128] = "";
+	size_t at_far = 0;
 	for (size_t k = 0; k < n; k++) {
 		const struct plan_region *g = &pl.regions[k];
 		int s = g->scale;
 		p.cpu_s += results[k].cpu_s;
 		p.invocations += results[k].attempts;
 		if (results[k].status != POV_OK) {
-			if (results[k].status == POV_CANCELLED && rc != POV_INTERRUPTED)
+			if (results[k].status == POV_CANCELLED && rc != POV_INTERRUPTED) {
 				stopped++;	/* the budget's deadline */
+				const struct pov_result *q = &results[k];
+				const double f = q->nprogress && q->progress_total > 0
+					? (double)q->progress[q->nprogress - 1].done /
+						  (double)q->progress_total : 0.0;
+				if (at_far < sizeof(how_far))
+					at_far += (size_t)snprintf(how_far + at_far,
+								   sizeof(how_far) - at_far,
+								   "%s%.0f%%", at_far ? ", " : "",
+								   100.0 * f);
+			}
 			if (results[k].status != POV_CANCELLED) {
 				p.failed++;
 				fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s%s%s\n",
@@ -2530,7 +2888,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	learn_costs(r, &pp, &pl, results);
 	if (stopped) {
 		progress(r, "pass %d: %d of %zu region renders stopped at the budget's end, "
-			 "their samples lost", pass, stopped, n);
+			 "their samples lost (done: %s of their pixels)", pass, stopped, n, how_far);
 		progress_end(r);
 	}
 	/* what a region render waits on besides its CPU, for the budget's
@@ -2789,6 +3147,17 @@ bad:
 		goto fail;
 	}
 	int first_pass = 1;
+	/* under a budget, the cost map, 1 everywhere until the base pass's
+	 * progress lines (base_cost_map()) or a pass's renders set it */
+	if (r.budget > 0.0) {
+		r.cost_map = malloc((size_t)r.w * r.h * sizeof *r.cost_map);
+		if (!r.cost_map) {
+			errbuf_printf(err, sizeof err, "out of memory");
+			goto fail;
+		}
+		for (size_t q = 0; q < (size_t)r.w * r.h; q++)
+			r.cost_map[q] = 1.0f;
+	}
 	if (r.resume) {
 		char *old = file_read_text(wpath(&r, "run.txt"));
 		if (!old) {
@@ -2841,10 +3210,7 @@ bad:
 	r.est = malloc((size_t)r.w * r.h * sizeof(*r.est));
 	r.noise = malloc((size_t)r.w * r.h * sizeof(*r.noise));
 	r.take = malloc((size_t)r.w * r.h * sizeof *r.take);
-	if (r.budget > 0.0 && (r.cost_map = malloc((size_t)r.w * r.h * sizeof *r.cost_map)))
-		for (size_t q = 0; q < (size_t)r.w * r.h; q++)
-			r.cost_map[q] = 1.0f;
-	if (!r.est || !r.noise || !r.take || (r.budget > 0.0 && !r.cost_map)) {
+	if (!r.est || !r.noise || !r.take) {
 		errbuf_printf(err, sizeof err, "out of memory");
 		goto fail;
 	}

@@ -232,6 +232,14 @@ static const char fake_script[] =
 	"segv) kill -SEGV $$;;\n"
 	"noout) exit 0;;\n"
 	"linger) echo whole > \"$out\"; echo 'Render Time: done' >&2; sleep 1; exit 0;;\n"
+	"progress) printf 'Rendered 50 of 100 pixels (50%%)\\r' >&2;"
+	" printf 'Rendered 10 of 100 pix' >&2; sleep 0.2;"
+	" printf 'els (10%%)\\rRendered 40 of 100 pixels (40%%)\\r' >&2; sleep 0.2;"
+	" printf 'Rendered 100 of 100 pixels (100%%)\\n' >&2; : > \"$out\";;\n"
+	"finish) printf 'Rendered 10 of 100 pixels (10%%)\\r' >&2; sleep 0.1;"
+	" printf 'Rendered 100 of 100 pixels (100%%)\\r' >&2; sleep 0.3; : > \"$out\";;\n"
+	"slow) printf 'Rendered 10 of 100 pixels (10%%)\\r' >&2; sleep 0.1;"
+	" printf 'Rendered 20 of 100 pixels (20%%)\\r' >&2; sleep 1; : > \"$out\";;\n"
 	"*) exit 3;;\n"
 	"esac\n";
 
@@ -1081,6 +1089,118 @@ static void test_pool_ready(void **state)
 	pov_result_release(&res);
 }
 
+/* With opts.progress, POV-Ray's progress lines as they were read: a line
+ * split across two reads is read whole, a count that falls starts again
+ * (the 50 before the 10), of the lines read at once only the last is kept
+ * (the 40, not the 10), and each has the time it came; without it, none.
+ * A job's progress asks POV-Ray for them (+V, not -V). */
+static void test_pool_progress(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512];
+	struct pov_job job = { 0 };
+	struct pov_result res;
+	struct pov_pool_opts o;
+	char **argv;
+	int argc, plus = 0, minus = 0;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "progress"), "s.pov");
+	setenv("FAKE_MODE", "progress", 1);
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "progress/o.exr");
+	job.width = 10;
+	job.height = 10;
+	job.povray = fake_bin;
+	pov_pool_opts_init(&o);
+	o.progress = 1;
+	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
+	assert_int_equal(res.status, POV_OK);
+	assert_int_equal(res.nprogress, 2);
+	assert_int_equal(res.progress_total, 100);
+	assert_int_equal(res.progress[0].done, 40);
+	assert_int_equal(res.progress[1].done, 100);
+	assert_true(res.progress[0].t >= 0.15);
+	assert_true(res.progress[1].t >= res.progress[0].t + 0.15);
+	pov_result_release(&res);
+	assert_null(res.progress);
+
+	o.progress = 0;
+	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
+	assert_int_equal(res.status, POV_OK);
+	assert_int_equal(res.nprogress, 0);
+	assert_null(res.progress);
+	pov_result_release(&res);
+
+	for (int p = 0; p < 2; p++) {
+		job.progress = p;
+		assert_int_equal(pov_argv_build(&job, &argv, &argc, err, sizeof(err)), 0);
+		for (int i = 0; i < argc; i++) {
+			plus += p == 1 && !strcmp(argv[i], "+V");
+			minus += p == 0 && !strcmp(argv[i], "-V");
+			assert_false(p == 1 && !strcmp(argv[i], "-V"));
+			assert_false(p == 0 && !strcmp(argv[i], "+V"));
+		}
+		pov_argv_free(argv);
+	}
+	assert_int_equal(plus, 1);
+	assert_int_equal(minus, 1);
+}
+
+/* At the deadline, with opts.finish_s and progress: a job whose lines say
+ * it has rendered its pixels (writing its image: 0.3 s more) is left
+ * finish_s to end, and ends well; without finish_s it is stopped; one
+ * whose lines say it has 1.6 s of pixels left is stopped at once. */
+static void test_pool_finish(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512];
+	struct pov_job job = { 0 };
+	struct pov_result res;
+	struct pov_pool_opts o;
+
+	(void)state;
+	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "finish"), "s.pov");
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "finish/o.exr");
+	job.width = 10;
+	job.height = 10;
+	job.povray = fake_bin;
+	job.progress = 1;
+	pov_pool_opts_init(&o);
+	o.progress = 1;
+	o.deadline_s = 0.2;
+	o.finish_s = 0.5;
+	setenv("FAKE_MODE", "finish", 1);
+	double t = now_s();
+	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
+	t = now_s() - t;
+	assert_int_equal(res.status, POV_OK);
+	assert_true(exists(out));
+	assert_true(t >= 0.35 && t < 0.7);
+	pov_result_release(&res);
+
+	o.finish_s = 0.0;
+	t = now_s();
+	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
+	t = now_s() - t;
+	assert_int_equal(res.status, POV_CANCELLED);
+	assert_false(exists(out));
+	assert_true(t < 0.35);
+	pov_result_release(&res);
+
+	o.finish_s = 0.5;
+	setenv("FAKE_MODE", "slow", 1);
+	t = now_s();
+	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
+	t = now_s() - t;
+	assert_int_equal(res.status, POV_CANCELLED);
+	assert_non_null(strstr(res.message, "deadline"));
+	assert_false(exists(out));
+	assert_true(t < 0.45);
+	assert_int_equal(res.nprogress, 2);
+	assert_int_equal(res.progress[1].done, 20);
+	pov_result_release(&res);
+}
+
 /* A deadline: the job running then is killed, those not started are not;
  * all are reported cancelled, the one done before it keeps its result. */
 static void test_pool_deadline(void **state)
@@ -1625,6 +1745,8 @@ int main(void)
 		cmocka_unit_test(test_render_parse_error),
 		cmocka_unit_test(test_timeout_kills),
 		cmocka_unit_test(test_pool_deadline),
+		cmocka_unit_test(test_pool_progress),
+		cmocka_unit_test(test_pool_finish),
 		cmocka_unit_test(test_sigint_stops_pool),
 		cmocka_unit_test(test_sigterm_stops_pool),
 		cmocka_unit_test(test_sigkill_leaves_no_orphans),
