@@ -1026,7 +1026,7 @@ static int log_says_never(void *arg, size_t index, const char *log)
  * the callback accepts it; when it does not, the pool waits. */
 static void test_pool_ready(void **state)
 {
-	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512];
+	char dir[PATH_MAX], scene[PATH_MAX], out[1][PATH_MAX], err[512];
 	struct pov_job job = { 0 };
 	struct pov_result res;
 	struct pov_pool_opts o;
@@ -1035,11 +1035,7 @@ static void test_pool_ready(void **state)
 	(void)state;
 	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "ready"), "s.pov");
 	setenv("FAKE_MODE", "linger", 1);
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "ready/o.exr");
-	job.width = 8;
-	job.height = 8;
-	job.povray = fake_bin;
+	fake_jobs(&job, 1, out, scene, "ready");
 	pov_pool_opts_init(&o);
 	o.ready = ready_cb;
 	o.arg = &l;
@@ -1050,7 +1046,7 @@ static void test_pool_ready(void **state)
 	assert_int_equal(res.term_signal, 0);
 	assert_int_equal(l.calls, 1);
 	assert_true(res.wall_s < 0.9);
-	assert_true(exists(out));
+	assert_true(exists(out[0]));
 	pov_result_release(&res);
 
 	l.calls = 0;
@@ -1059,7 +1055,7 @@ static void test_pool_ready(void **state)
 	assert_int_equal(res.status, POV_OK);
 	assert_int_equal(l.calls, 1);
 	assert_true(res.wall_s >= 1.0);
-	assert_true(exists(out));
+	assert_true(exists(out[0]));
 	pov_result_release(&res);
 
 	/* accepted, and done when the console says so: at once when it says
@@ -1096,7 +1092,7 @@ static void test_pool_ready(void **state)
  * A job's progress asks POV-Ray for them (+V, not -V). */
 static void test_pool_progress(void **state)
 {
-	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512];
+	char dir[PATH_MAX], scene[PATH_MAX], out[1][PATH_MAX], err[512];
 	struct pov_job job = { 0 };
 	struct pov_result res;
 	struct pov_pool_opts o;
@@ -1106,11 +1102,7 @@ static void test_pool_progress(void **state)
 	(void)state;
 	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "progress"), "s.pov");
 	setenv("FAKE_MODE", "progress", 1);
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "progress/o.exr");
-	job.width = 10;
-	job.height = 10;
-	job.povray = fake_bin;
+	fake_jobs(&job, 1, out, scene, "progress");
 	pov_pool_opts_init(&o);
 	o.progress = 1;
 	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
@@ -1152,18 +1144,14 @@ static void test_pool_progress(void **state)
  * whose lines say it has 1.6 s of pixels left is stopped at once. */
 static void test_pool_finish(void **state)
 {
-	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], err[512];
+	char dir[PATH_MAX], scene[PATH_MAX], out[1][PATH_MAX], err[512];
 	struct pov_job job = { 0 };
 	struct pov_result res;
 	struct pov_pool_opts o;
 
 	(void)state;
 	make_tiny_scene(scene, sizeof(scene), scratch(dir, sizeof(dir), "finish"), "s.pov");
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "finish/o.exr");
-	job.width = 10;
-	job.height = 10;
-	job.povray = fake_bin;
+	fake_jobs(&job, 1, out, scene, "finish");
 	job.progress = 1;
 	pov_pool_opts_init(&o);
 	o.progress = 1;
@@ -1174,7 +1162,7 @@ static void test_pool_finish(void **state)
 	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
 	t = now_s() - t;
 	assert_int_equal(res.status, POV_OK);
-	assert_true(exists(out));
+	assert_true(exists(out[0]));
 	assert_true(t >= 0.35 && t < 0.7);
 	pov_result_release(&res);
 
@@ -1183,7 +1171,7 @@ static void test_pool_finish(void **state)
 	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
 	t = now_s() - t;
 	assert_int_equal(res.status, POV_CANCELLED);
-	assert_false(exists(out));
+	assert_false(exists(out[0]));
 	assert_true(t < 0.35);
 	pov_result_release(&res);
 
@@ -1194,7 +1182,7 @@ static void test_pool_finish(void **state)
 	t = now_s() - t;
 	assert_int_equal(res.status, POV_CANCELLED);
 	assert_non_null(strstr(res.message, "deadline"));
-	assert_false(exists(out));
+	assert_false(exists(out[0]));
 	assert_true(t < 0.45);
 	assert_int_equal(res.nprogress, 2);
 	assert_int_equal(res.progress[1].done, 20);
