@@ -231,7 +231,7 @@ enum {
  * 4.3e-5 in 4.87).  Its threshold is the hidden-edge term's
  * (ACC_AA_THRESHOLD).
  */
-#define ACC_AA_SPREAD_R3_THRESHOLD 0.1
+#define ACC_AA_SPREAD_R3_THRESHOLD ACC_AA_THRESHOLD
 #define ACC_AA_SPREAD_R3_SIDE 3
 #define ACC_AA_SPREAD_R3_CELLS (4 * ACC_AA_SPREAD_R3_SIDE * ACC_AA_SPREAD_R3_SIDE)
 /*

@@ -52,6 +52,7 @@
 #define POV_LOG_MAX (1u << 20)	/* console output kept per attempt (its tail) */
 #define POV_MAX_SIZE 1000000	/* largest +W / +H accepted */
 #define POV_MAX_THREADS 4096
+#define DEADLINE_GRACE_S 0.05	/* SIGTERM to SIGKILL for a job past the deadline */
 #define POV_TICK_S 0.1		/* longest wait between checks of the children */
 
 extern char **environ;
@@ -1288,7 +1289,7 @@ struct pjob {
 				 * for a while after its release, or -1 */
 	double released;	/* when its gate was opened */
 	struct buf log;
-	/* with the pool's opts->progress: the progress lines read so far
+	/* with its job's progress: the progress lines read so far
 	 * (struct pov_result's), and the tail of the output they were last
 	 * looked for in, for a line split across reads */
 	int want_progress;
@@ -1477,7 +1478,7 @@ static void note_progress(struct pjob *j, const char *chunk, size_t n, double t)
 		if (j->nprog && done < j->prog[j->nprog - 1].done)
 			j->nprog = 0;	/* a new run of lines */
 		if (j->nprog && done == j->prog[j->nprog - 1].done)
-			continue;	/* seen in the last tail */
+			continue;	/* a count repeated */
 		if (j->nprog && t - j->prog_since < PROGRESS_BATCH_S) {
 			/* the read's last, or a batch split over reads */
 			j->prog[j->nprog - 1].t = t;
@@ -1725,7 +1726,10 @@ static void pool_early(struct pool *p)
 }
 
 /* Whether running job j's progress lines say it will have rendered its
- * pixels within s seconds of now, at its rate over its lines. */
+ * pixels within s seconds of now: those left at its rate over its lines,
+ * and the time since its last line added, not taken off (lines that have
+ * stopped coming are a render slowing, and a render left past the
+ * deadline in error costs the budget). */
 static int job_finishing(const struct pjob *j, double now, double s)
 {
 	if (j->nprog < 2 || j->prog_total <= 0)
@@ -1929,7 +1933,7 @@ static void pool_check(struct pool *p)
 		if (j->stop == STOP_NONE && p->opts->timeout_s > 0 && now >= j->deadline)
 			stop_job(j, STOP_TIMEOUT, now, p->opts->grace_s);
 		if (j->stop == STOP_NONE && j->finish_by > 0 && now >= j->finish_by)
-			stop_job(j, STOP_DEADLINE, now, 0.05);	/* as pool_run()'s */
+			stop_job(j, STOP_DEADLINE, now, DEADLINE_GRACE_S);
 		if (j->kill_at && !j->killed && now >= j->kill_at) {
 			kill(-j->pid, SIGKILL);
 			j->killed = 1;
@@ -2034,6 +2038,7 @@ int pov_prelaunch_start(const struct pov_job *jobs, size_t njobs, const char *ga
 	for (size_t k = 0; k < njobs; k++) {
 		pre->pj[k].fd = -1;
 		pre->pj[k].gate = -1;
+		pre->pj[k].want_progress = jobs[k].progress;
 	}
 	devnull = open("/dev/null", O_RDWR | O_CLOEXEC);
 	if (devnull >= 0)
@@ -2113,7 +2118,6 @@ static void prelaunch_take(struct pool *p, struct pov_prelaunch *pre)
 			pre->pj[k].fd = -1;
 			pre->pj[k].gate = -1;
 			j->state = J_RUNNING;
-			j->want_progress = p->opts->progress;
 			gate_replace(pre->gate[k]);
 			p->res[i].prelaunched = 1;
 			pre->taken++;
@@ -2169,7 +2173,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 	for (size_t i = 0; i < njobs; i++) {
 		p.pj[i].fd = -1;
 		p.pj[i].gate = -1;
-		p.pj[i].want_progress = opts->progress;
+		p.pj[i].want_progress = jobs[i].progress;
 	}
 	/* Everything that can be checked is checked before anything starts. */
 	for (size_t i = 0; i < njobs; i++) {
@@ -2236,7 +2240,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 				pool_notice(&p);
 				pool_early(&p);
 			}
-			pool_stop(&p, STOP_DEADLINE, 0.05);
+			pool_stop(&p, STOP_DEADLINE, DEADLINE_GRACE_S);
 		}
 		pool_fill(&p);
 		if (!p.running && (p.stopping || p.done == njobs))

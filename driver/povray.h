@@ -108,8 +108,8 @@ struct pov_job {
 					 * options when the scene has none */
 	int progress;			/* +V rather than -V: POV-Ray prints a
 					 * "Rendered N of M pixels" line as each
-					 * block ends (struct pov_result's
-					 * progress, with the pool's) */
+					 * block ends, which the pool keeps
+					 * (struct pov_result's progress) */
 };
 
 /* What POV-Ray's statistics report about one run. */
@@ -242,7 +242,7 @@ struct pov_result {
 	int prelaunched;		/* its first attempt was taken from
 					 * opts->prelaunched: wall_s and start_s
 					 * count from its release */
-	/* With opts->progress: POV-Ray's "Rendered N of M pixels" lines of
+	/* For a job with progress: POV-Ray's "Rendered N of M pixels" lines of
 	 * the last attempt as they were read, each when (seconds after the
 	 * attempt started) and N, the last rising run of them (a count that
 	 * falls starts again); owned, NULL when none */
@@ -296,10 +296,7 @@ struct pov_pool_opts {
 	 * pov_prelaunch_start()); the rest of the set is stopped before any
 	 * job starts.  The set is spent: end it with pov_prelaunch_end(). */
 	struct pov_prelaunch *prelaunched;
-	/* If set: each result's progress (POV-Ray's progress lines, timed
-	 * as read; see struct pov_result). */
-	int progress;
-	/* If > 0, with progress: at deadline_s, a running job whose progress
+	/* If > 0: at deadline_s, a running job with progress whose progress
 	 * lines say it will have rendered its pixels within half of finish_s
 	 * (those left at its rate so far; the last line's count its whole:
 	 * done rendering, writing its image) is left finish_s to end before

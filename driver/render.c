@@ -515,6 +515,9 @@ static void pass_job(const struct run *r, int pass, struct pov_job *job, const c
 	pd->value = passno;
 	job->defines = pd;
 	job->ndefines = 1;
+	/* under a budget, how far a render stopped at its end got, and
+	 * whether it is about to finish (pov_pool_opts' finish_s) */
+	job->progress = r->budget > 0.0;
 }
 
 static void on_done(void *arg, size_t index, const struct pov_result *res)
@@ -838,11 +841,6 @@ static int rad_prelaunched(const struct run *r, int k)
 
 static const struct pov_define pass0 = { "POVPRESS_PASS", "0" };
 
-/* POV-Ray's blocks' side (its default +BS), and the fewest reads of the
- * base pass's progress lines a cost map is made from (base_cost_map()) */
-#define POV_BLOCK 32
-#define MAP_MIN_READS 16
-
 /* whole_frame()'s job; extra has room for r->nextra + 1. */
 static void frame_job(const struct run *r, int k, int threads, const char *out,
 		      const char *radfile, struct pov_job *job, const char **extra)
@@ -863,10 +861,11 @@ static void frame_job(const struct run *r, int k, int threads, const char *out,
  * the given threads into out, saving the radiosity data to radfile: the
  * base pass and the radiosity pass.  what names it in messages; deadline is
  * seconds from now to stop POV-Ray at (0: none), a render stopped there an
- * error.  Returns 0, -1 on failure (err says why), POV_INTERRUPTED.
+ * error; with progress, POV-Ray's progress lines are kept in res.  Returns
+ * 0, -1 on failure (err says why), POV_INTERRUPTED.
  */
 static int whole_frame(struct run *r, int k, int threads, const char *out,
-		       const char *radfile, const char *what, double deadline,
+		       const char *radfile, const char *what, double deadline, int progress,
 		       struct pov_result *res, char *err, size_t errlen)
 {
 	const char **extra = calloc(r->nextra + 8, sizeof(char *));
@@ -876,13 +875,7 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
 	}
 	struct pov_job job;
 	frame_job(r, k, threads, out, radfile, &job, extra);
-	/* the base pass's progress lines, for base_cost_map(), where the
-	 * frame has blocks enough for MAP_MIN_READS reads of them (at
-	 * 160x120, 20 blocks, glossy_reflection's came in 8 to 10 reads);
-	 * elsewhere they would only cost POV-Ray's frontend their printing */
-	job.progress = r->cost_map != NULL && k == 1 && !strcmp(what, "base pass") &&
-		       (long)((r->w + POV_BLOCK - 1) / POV_BLOCK) * ((r->h + POV_BLOCK - 1) / POV_BLOCK) >=
-			       4 * MAP_MIN_READS;
+	job.progress = progress;
 	struct pov_pool_opts po;
 	pov_pool_opts_init(&po);
 	po.max_jobs = 1;
@@ -892,7 +885,6 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
 	po.prelaunched = rad_prelaunched(r, k) ? r->pre : NULL;
 	po.timeout_s = r->timeout > 0 ? r->timeout : 0.0;
 	po.deadline_s = deadline;
-	po.progress = job.progress;
 	double written = 0.0;
 	po.ready = note_written;
 	po.ready_log = stats_printed;
@@ -1117,7 +1109,8 @@ static int radiosity_pass(struct run *r, int k, struct pass_rec *p, char *err, s
 	 * POV-Ray computes another solution every run, some much worse
 	 * (radiosity_room at 640x480: relMSE 0.8e-3 to 2.6e-3 in three runs
 	 * on two threads, 1.0e-3 on one; the same script) */
-	int ret = whole_frame(r, k, threads, out, rad, "radiosity pass", 0.0, &res, err, errlen);
+	int ret = whole_frame(r, k, threads, out, rad, "radiosity pass", 0.0, 0, &res, err,
+			      errlen);
 	if (ret)
 		goto out;
 	ret = -1;
@@ -1180,15 +1173,23 @@ out:
  * where the error sits in few pixels), in min(cores, jobs) bands; a later
  * pass's: the next scale of the pass before's main kind, in twice as many.
  */
-static int is_user_header(const char *a)
+
+/* Whether POV-Ray option a, one of the user's, may set what switch sw
+ * (+sw or -sw, its start) or INI key `key` sets: it is the switch, holds
+ * the key, or is an INI file, which may hold it. */
+static int user_sets(const char *a, const char *sw, const char *key)
 {
-	size_t n = strlen(a);
-	if ((a[0] == '+' || a[0] == '-') && !strncasecmp(a + 1, "hi", 2))
+	const size_t n = strlen(a), ns = strlen(sw), nk = strlen(key);
+	if ((a[0] == '+' || a[0] == '-') && !strncasecmp(a + 1, sw, ns))
 		return 1;
-	for (size_t i = 0; i + 14 <= n; i++)
-		if (!strncasecmp(a + i, "include_header", 14))
+	for (size_t i = 0; i + nk <= n; i++)
+		if (!strncasecmp(a + i, key, nk))
 			return 1;
 	return n > 4 && !strcasecmp(a + n - 4, ".ini");
+}
+static int is_user_header(const char *a)
+{
+	return user_sets(a, "hi", "include_header");
 }
 
 struct pre_kind {
@@ -1304,7 +1305,6 @@ static void prelaunch_start(struct run *r, int pass, const struct pre_kind *kind
 			g->edges = kinds[t].edges;
 			plan_output_name(outs[n], sizeof outs[n], r->workdir, pass, n, g->scale);
 			plan_job(&base, g, outs[n], &regs[n], extras + n * (r->nextra + 4), &jobs[n]);
-			jobs[n].progress = r->budget > 0.0;	/* as refine_pass()'s */
 			n++;
 		}
 	}
@@ -1494,39 +1494,49 @@ static size_t prelaunch_cover(struct run *r, int pass, struct plan *pl, size_t *
  * reads), smoothed over BLOCK_SMOOTH blocks either side in that order (a
  * block ends out of order by up to the threads' count), over the frame's
  * mean; the blocks before the first read take the first measured one's.
- * Where the user's options set the blocks' size or order (+BS, +RP), the
- * reads' steps are not mostly whole blocks, there are fewer than
- * MAP_MIN_READS reads (glossy_reflection at 160x120: 10, at 320x240 50),
- * or the cost of a sample is the user's (--cost-sample: a plan that timing
- * does not move), the map stays 1.  Debian's textures/finishes/var_refl at
- * 640x480 (`povray +W640 +H480 -A +WT2 +V`, its lines timed as read): the
+ * Where the base pass printed no lines (map_wanted(); --cost-sample: a
+ * plan that timing does not move), the reads' steps are not mostly whole
+ * blocks, or there are fewer than MAP_MIN_READS reads (glossy_reflection
+ * at 320x240: 17), the map stays 1.  Debian's textures/finishes/var_refl at
+ * 640x480 (`povray +W640 +H480 -A +WT2`, its lines timed as read): the
  * upper half's 153,600 pixels in 0.04 s, the lower half's in 0.15 s; at
  * twice the size on one thread (+SR/+ER halves) 0.38 and 1.16 CPU s.  The
  * map priced both halves at the mean, and pass 1's renders of the lower
  * half ran into the deadline.
  */
+#define POV_BLOCK 32
+#define MAP_MIN_READS 16
 #define BLOCK_SMOOTH 2
 #define COST_MIN 0.02
 #define COST_MAX 50.0
+/* Whether a run's base pass should print its progress lines for
+ * base_cost_map(): under a budget, the cost of a sample measured, a frame
+ * of blocks enough for MAP_MIN_READS reads of them (at 160x120, 20 blocks,
+ * glossy_reflection's came in 8 reads; elsewhere the lines would only cost
+ * POV-Ray's frontend their printing), the blocks' size and order
+ * POV-Ray's defaults (not +BS, +RP or +RS, the block step, of the user's). */
+static int map_wanted(const struct run *r)
+{
+	const long blocks = (long)((r->w + POV_BLOCK - 1) / POV_BLOCK) *
+			    ((r->h + POV_BLOCK - 1) / POV_BLOCK);
+	if (!r->cost_map || r->user_cost_sample > 0.0 || blocks < 4 * MAP_MIN_READS)
+		return 0;
+	for (size_t k = 0; k < r->nextra; k++)
+		if (user_sets(r->extra[k], "bs", "render_block_size") ||
+		    user_sets(r->extra[k], "rp", "render_pattern") ||
+		    user_sets(r->extra[k], "rs", "render_block_step"))
+			return 0;
+	return 1;
+}
+
 static int base_cost_map(struct run *r, const struct pov_result *res)
 {
 	const struct pov_progress *pg = res->progress;
 	const size_t np = res->nprogress;
 	const long all = (long)r->w * r->h;
-	if (!r->cost_map || r->user_cost_sample > 0.0 || np < MAP_MIN_READS ||
-	    res->progress_total != all)
+	if (!map_wanted(r) || np < MAP_MIN_READS || res->progress_total != all)
 		return 0;
-	/* the blocks' size and order are POV-Ray's defaults: not the user's
-	 * (+BS, +RP), and the lines' steps whole blocks (full ones, or with
-	 * a last column's or row's) */
-	for (size_t k = 0; k < r->nextra; k++) {
-		const char *o = r->extra[k];
-		if ((o[0] == '+' || o[0] == '-') && (!strncasecmp(o + 1, "BS", 2) ||
-						     !strncasecmp(o + 1, "RP", 2)))
-			return 0;
-		if (!strncasecmp(o, "Render_Block", 12) || !strncasecmp(o, "Render_Pattern", 14))
-			return 0;
-	}
+	/* the reads' steps mostly whole blocks (a last row's are not) */
 	long full = 0;
 	for (size_t i = 1; i < np; i++)
 		if ((pg[i].done - pg[i - 1].done) % ((long)POV_BLOCK * POV_BLOCK) == 0)
@@ -1624,6 +1634,7 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	 * (a scene whose base pass takes minutes, given --budget 20, would
 	 * otherwise run for minutes) */
 	int ret = whole_frame(r, 1, r->cores, out, r->radfile, "base pass", deadline_in(r, 0.0),
+			      map_wanted(r),
 			      &res, err, errlen);
 	if (ret)
 		goto out;
@@ -1774,6 +1785,20 @@ static int sparse_error(const struct run *r, int *memo)
 	return *memo;
 }
 
+/* pl's antialiased regions after the others, each part in its order: they
+ * are folded last (choose_samplers()). */
+static void aa_last(struct plan *pl)
+{
+	size_t m = 0;
+	for (size_t k = 0; k < pl->nregions; k++) {
+		struct plan_region g = pl->regions[k];
+		if (g.scale == ACC_AA)
+			continue;
+		memmove(pl->regions + m + 1, pl->regions + m, (k - m) * sizeof(g));
+		pl->regions[m++] = g;
+	}
+}
+
 /*
  * The sampler of each region of a plan.  With --sampler auto, where the
  * error sits in a few pixels or at edges (sparse_error()), the regions of scale 2 are
@@ -1805,24 +1830,21 @@ static size_t choose_samplers(const struct run *r, struct plan *pl, int *sparse)
 			  sparse_error(r, sparse);
 	if (!first && !r->aa)
 		return 0;
-	size_t m = 0;
+	size_t n = 0;
 	for (size_t k = 0; k < pl->nregions; k++) {
-		struct plan_region g = pl->regions[k];
-		long area = plan_region_area(&g);
-		if (first ? g.scale == 2 : g.scale >= 8 && 2 * lacking_aa(r, &g) >= area)
+		struct plan_region *g = &pl->regions[k];
+		const int take = first ? g->scale == 2
+				       : g->scale >= 8 && 2 * lacking_aa(r, g) >= plan_region_area(g);
+		if (!take)
 			continue;
-		memmove(pl->regions + m + 1, pl->regions + m, (k - m) * sizeof(g));
-		pl->regions[m++] = g;
+		g->scale = ACC_AA;
+		g->frame = first ? ACC_GRID_FRAME : 0;
+		g->edges = first && *sparse == SPARSE_EDGES ? ACC_AA_FOR_EDGES : ACC_AA_FOR_FEW;
+		g->depth = !first ? 0 : g->edges ? ACC_AA_EDGE_DEPTH : ACC_AA_DEPTH;
+		n++;
 	}
-	for (size_t k = m; k < pl->nregions; k++) {
-		pl->regions[k].scale = ACC_AA;
-		pl->regions[k].frame = first ? ACC_GRID_FRAME : 0;
-		pl->regions[k].edges = first && *sparse == SPARSE_EDGES ? ACC_AA_FOR_EDGES
-									 : ACC_AA_FOR_FEW;
-		pl->regions[k].depth = !first ? 0 : pl->regions[k].edges ? ACC_AA_EDGE_DEPTH
-									: ACC_AA_DEPTH;
-	}
-	return first ? pl->nregions - m : 0;
+	aa_last(pl);
+	return first ? n : 0;
 }
 
 /*
@@ -1952,20 +1974,6 @@ static void back_to_scale2(struct plan_region *g)
 	g->depth = 0;
 }
 
-/* pl's antialiased regions after the others, each part in its order: they
- * are folded last (choose_samplers()). */
-static void aa_last(struct plan *pl)
-{
-	size_t m = 0;
-	for (size_t k = 0; k < pl->nregions; k++) {
-		struct plan_region g = pl->regions[k];
-		if (g.scale == ACC_AA)
-			continue;
-		memmove(pl->regions + m + 1, pl->regions + m, (k - m) * sizeof(g));
-		pl->regions[m++] = g;
-	}
-}
-
 /* aa_depth() where +R3 over all of a plan's antialiased regions does not
  * fit: the regions whose +R3 costs (c3, by region, from aa_depth(); NULL
  * when it ran out of memory: none) least more than their scale 2 keep it
@@ -1981,14 +1989,12 @@ static size_t aa_some(struct plan *pl, const struct plan_params *pp, const doubl
 {
 	const size_t n = pl->nregions;
 	unsigned char *keep = calloc(n, 1);
-	struct plan_region *to = malloc(n * sizeof(*to));
 	size_t kept = 0;
-	if (!c3 || !keep || !to) {	/* out of memory: all back at scale 2, in place */
+	if (!c3 || !keep) {	/* out of memory: all back at scale 2, in place */
 		for (size_t k = 0; k < n; k++)
 			if (pl->regions[k].depth)
 				back_to_scale2(&pl->regions[k]);
 		free(keep);
-		free(to);
 		return 0;
 	}
 	double total = 0.0;
@@ -2009,26 +2015,21 @@ static size_t aa_some(struct plan *pl, const struct plan_params *pp, const doubl
 		keep[b] = 1;
 		total += extra;
 	}
-	/* the plan's scaled regions, those back at scale 2, then those kept at
-	 * +R3, each in their order */
-	size_t m = 0;
-	for (int part = 0; part < 3; part++)
-		for (size_t k = 0; k < n; k++) {
-			const struct plan_region *g = &pl->regions[k];
-			if (part != (!g->depth ? 0 : keep[k] ? 2 : 1))
-				continue;
-			to[m] = *g;
-			if (part == 1) {
-				back_to_scale2(&to[m]);
-			} else if (part == 2) {
-				to[m].depth = 3;
-				kept++;
-			}
-			m++;
+	/* the plan's scaled regions, those back at scale 2 (the antialiased
+	 * ones being last), then those kept at +R3, each in their order */
+	for (size_t k = 0; k < n; k++) {
+		struct plan_region *g = &pl->regions[k];
+		if (!g->depth)
+			continue;
+		if (keep[k]) {
+			g->depth = 3;
+			kept++;
+		} else {
+			back_to_scale2(g);
 		}
-	memcpy(pl->regions, to, n * sizeof(*to));
+	}
+	aa_last(pl);
 	free(keep);
-	free(to);
 	return kept;
 }
 static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_params *pp,
@@ -2110,9 +2111,9 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
  * not look).
  */
 #define SPREAD_SAMPLE_S 1.5e-6
-#define SPREAD_MARGIN 1.25
 /*
- * The margin's measure.  The price missed the pass's CPU at every level:
+ * What a level's price is taken times against what the pass may spend.
+ * The price missed the pass's CPU at every level:
  * over soft_shadows, thin_geometry and Debian's var_refl, noise_generator,
  * swirlbox and granite at 640x480 (`--budget 40 --target 1e-6
  * --max-passes 1`, each level forced by a scratch switch, 2026-12-05 02:40
@@ -2122,11 +2123,13 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
  * +R3 priced at 1.7 core-s of 2.2, and in two runs of three one of its
  * four renders was stopped at the deadline (relMSE 4.8e-3 to 5.7e-3,
  * against 5.7e-4 by +R2).  Priced by the base pass's cost map
- * (base_cost_map()), the same runs on the seven scenes (granite too,
- * 03:57 to 04:02 UTC) took 0.83 to 1.25 times the price (median 1.12;
- * without the map, the same build, 0.87 to 1.43), so every level takes
- * SPREAD_MARGIN.
+ * (base_cost_map()), the same runs on the six took 0.85 to 1.32 times the
+ * price (median 1.15; without the map, the same build, 0.87 to 1.44;
+ * 05:19 to 05:22 UTC), so every level takes SPREAD_MARGIN: by turns
+ * against the build before at 640x480 under 2, 3 and 6 s (54 runs, 04:46
+ * to 04:53 UTC) no render was lost at the deadline.
  */
+#define SPREAD_MARGIN 1.25
 /*
  * The renders a pass's scale-2 regions may become, in the order tried:
  * +A0.03 +R4 (ACC_AA_SPREAD_DEPTH), then under a budget that it does not
@@ -2210,15 +2213,18 @@ static double mix_makespan(const struct plan *pl, const double *price, int t,
  * started last can outlast the others).  The mixed pass fills the budget
  * where the whole level left a step of it spare, and a render stopped at
  * the deadline loses all it did: without the slack and spare, under
- * --budget 2 at 640x480 one run in three of soft_shadows, thin_geometry
- * and noise_generator and every run of var_refl lost one or two renders
- * (relMSE 1.2e-3 to 7.8e-3 against 7.5e-5 to 2.1e-3 for the others;
- * 2026-12-05 03:32 to 03:41 UTC).  No region moves up to the first level,
+ * --budget 2 at 640x480 one run in three of soft_shadows and
+ * thin_geometry, two of noise_generator and every run of var_refl lost
+ * renders (relMSE 1.3e-3 to 7.8e-3, against 7.6e-5 to 3.8e-4 in the
+ * others' runs; 2026-12-05 03:32 to 03:41 UTC).  No region moves up to the first level,
  * +A0.03 +R4, whose 64 cells at each edge pixel make a region's price the
  * least sure: soft_shadows under --budget 3 took it on two of four
- * regions beside +A0.1 +R3 and lost one of them, 48% done, at the
- * deadline in four runs of six (relMSE 1.4e-3 to 1.6e-3, against 1.2e-4
- * with +A0.1 +R3 whole; 04:35 to 04:50 UTC).
+ * regions beside +A0.1 +R3 and lost a render at the deadline in four
+ * runs of six (relMSE 1.4e-3 to 1.6e-3, against 1.2e-4 with +A0.1 +R3
+ * whole; 04:31 to 04:48 UTC; one printed it 48% done).  Where no level
+ * fits (t NSPREAD), regions move up to the last level without
+ * SPREAD_R2_SHARE's test: the pass then spends what it may on scale 2
+ * and the moves together, not a small share of it.
  * Each level lies a step of the budget from the next (their prices 1.3 to
  * 2 times apart), and the first pass took it whole or not at all: swirlbox
  * (Debian's advanced/swirlbox) at 640x480 under --budget 2 priced +A0.3
@@ -2233,7 +2239,10 @@ static int by_score_desc(const void *a, const void *b)
 {
 	const double x = ((const struct mix_cand *)a)->score,
 		     y = ((const struct mix_cand *)b)->score;
-	return (x < y) - (x > y);
+	if (x != y)
+		return (x < y) - (x > y);
+	const size_t i = ((const struct mix_cand *)a)->k, j = ((const struct mix_cand *)b)->k;
+	return (i > j) - (i < j);	/* in the plan's order, whatever qsort() does */
 }
 #define MIX_SLACK 0.85
 #define MIX_SPARE_S 0.1
@@ -2624,9 +2633,9 @@ enum { PASS_STOP = 2 };
  * rendered its pixels by then is left to end (pov_pool_opts' finish_s),
  * at most FINISH_SHARE of the budget.  Stopped at the deadline, a render
  * loses all it did: Debian's textures/finishes/var_refl at 640x480 under
- * --budget 2, one run in four, lost a render of 1.0 core-s that had
- * rendered all its pixels and was writing its image (its progress lines,
- * 2026-12-05): relMSE 9.0e-3, the others 2.6e-3 to 2.8e-3.  POV-Ray
+ * --budget 2, one run in four, lost a render that had rendered all its
+ * pixels and was writing its image (its progress lines, 2026-12-05):
+ * estimated relMSE 9.0e-3, the others 2.6e-3 to 2.8e-3.  POV-Ray
  * wrote the image of a region render at 1280x960 and exited 0.06 to 0.32 s
  * after its last progress line (var_refl's lower half at +AM1 +A0.3 +R2,
  * swirlbox's upper half without antialiasing, two runs each, with
@@ -2766,8 +2775,6 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		}
 		plan_job(&base, &pl.regions[k], outs[k], &regs[k], extras + k * (r->nextra + 4),
 			 &jobs[k]);
-		/* under a budget, how far a render stopped at its end got */
-		jobs[k].progress = r->budget > 0.0;
 	}
 	/* what this pass renders, for inspection and for running elsewhere */
 	if (plan_regions_save(wpath(r, "regions.tsv"), &pl, pass, outs, err, errlen))
@@ -2775,7 +2782,6 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	struct pov_pool_opts po;
 	pov_pool_opts_init(&po);
 	po.max_jobs = r->jobs < (int)n ? r->jobs : (int)n;
-	po.progress = r->budget > 0.0;
 	po.timeout_s = r->timeout;
 	if (po.timeout_s <= 0.0) {
 		/* a minute plus ten times what the dearest region should cost:
@@ -2855,11 +2861,13 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 				const double f = q->nprogress && q->progress_total > 0
 					? (double)q->progress[q->nprogress - 1].done /
 						  (double)q->progress_total : 0.0;
+				char one[16] = "not started";
+				if (q->attempts)
+					snprintf(one, sizeof(one), "%.0f%%", 100.0 * f);
 				if (at_far < sizeof(how_far))
 					at_far += (size_t)snprintf(how_far + at_far,
-								   sizeof(how_far) - at_far,
-								   "%s%.0f%%", at_far ? ", " : "",
-								   100.0 * f);
+								   sizeof(how_far) - at_far, "%s%s",
+								   at_far ? ", " : "", one);
 			}
 			if (results[k].status != POV_CANCELLED) {
 				p.failed++;
@@ -3186,8 +3194,10 @@ bad:
 		first_pass = r.passes[r.npasses - 1].pass + 1;
 		progress(&r, "resuming after pass %d (%.1f s so far)", first_pass - 1, r.prev_wall);
 	} else {
-		if (file_mkdirs(r.workdir, "work directory", err, sizeof err))
+		if (file_mkdirs(r.workdir, "work directory", err, sizeof err)) {
+			free(r.cost_map);
 			goto fail_early;
+		}
 		/* a fresh run: forget a previous one here */
 		unlink(wpath(&r, "progress.txt"));
 		unlink(wpath(&r, "accum.exr"));

@@ -598,22 +598,24 @@ spend() { sed -n 's/.*the pass may spend \([0-9.]*\)$/\1/p' "$1" | tail -n 1; }
 # ere TEXT: TEXT as an extended regular expression matching it alone
 ere() { printf '%s' "$1" | sed 's/[]\\.+*?(){}|^$[]/\\&/g'; }
 
-# spread_level SCENE TAG LOW HIGH MLOW MHIGH: the first refinement pass of SCENE at
+# spread_level SCENE TAG LOW HIGH: the first refinement pass of SCENE at
 # 320x240 on one core, the cost of a sample pinned at 1e-6 s (spread error,
 # its scale-2 regions rendered by POV-Ray's +AM1 at twice the size), under
 # a budget that fits the render level LOW (as -v names it) but not the one
-# tried before it, HIGH, their prices taken with the margins MLOW and MHIGH
-# (render.c's SPREAD_MARGIN and SPREAD_MARGIN_LIGHT): a run under 30 s
+# tried before it, HIGH, their prices taken with render.c's SPREAD_MARGIN
+# (spread_margin): a run under 30 s
 # ($T/TAG-30.exr) prints each level's price and what the pass may spend,
 # (budget - elapsed - latency - 0.2) x 0.8 core-s on one core, and the
 # budget is moved so that the pass may spend the geometric middle of the
-# two prices with their margins ($T/TAG.exr, its
+# two prices with the margin ($T/TAG.exr, its
 # log TAG.log and report TAG.json; moved again, up to three times, where
-# it missed).  Checks that the pass so took LOW,
+# it missed).  Checks that the pass so took LOW (on some regions, HIGH on
+# the rest),
 # rendered at twice the size, marked its pixels and ended within the
 # budget; fails when a run fails.
+spread_margin=1.25
 spread_level() {
-	local scene=$1 tag=$2 lo=$3 hi=$4 mlo=$5 mhi=$6 b plo phi may m2 a1 try
+	local scene=$1 tag=$2 lo=$3 hi=$4 m=$spread_margin b plo phi may m2 a1 try
 	local sp=(taskset -c 0 "$PP" render "$scene" -W 320 -H 240 --target 1e-6 --max-passes 1
 		--cost-sample 1e-6 --cost-job 0.05 -v --keep-workdir)
 	"${sp[@]}" -o "$T/$tag-30.exr" --budget 30 -- +WT1 2>"$T/$tag-30.log" ||
@@ -629,8 +631,8 @@ spread_level() {
 	# the pass's plan (and so the prices) moved with the budget (a
 	# sanitized build's slower analysis leaves the plan less time)
 	for try in 1 2 3 4; do
-		b=$(awk -v b="$b" -v h="${phi:-1}" -v l="${plo:-1}" -v m="${may:-1}" -v x="$mlo" \
-			-v y="$mhi" 'BEGIN { printf "%.2f", b - (m - sqrt(x * l * y * h)) / 0.8 }')
+		b=$(awk -v b="$b" -v h="${phi:-1}" -v l="${plo:-1}" -v m="${may:-1}" -v x="$m" \
+			-v y="$m" 'BEGIN { printf "%.2f", b - (m - sqrt(x * l * y * h)) / 0.8 }')
 		"${sp[@]}" -o "$T/$tag.exr" --budget "$b" --report "$T/$tag.json" -- +WT1 \
 			2>"$T/$tag.log" ||
 			{ bad "$(basename "$scene") 320x240 --budget $b: render failed"; return 1; }
@@ -638,10 +640,10 @@ spread_level() {
 		phi=$(price "$T/$tag.log" "$hi")
 		m2=$(spend "$T/$tag.log")
 		may=$m2
-		num "a >= $mlo * b && a < $mhi * c" "${m2:-0}" "${plo:-1}" "${phi:-0}" && break
+		num "a >= $m * b && a < $m * c" "${m2:-0}" "${plo:-1}" "${phi:-0}" && break
 	done
-	check "... under $b s the pass may spend $m2, between $mlo times $lo's $plo and $mhi times $hi's $phi" \
-		num "a >= $mlo * b && a < $mhi * c" "${m2:-0}" "${plo:-1}" "${phi:-0}"
+	check "... under $b s the pass may spend $m2, between $m times $lo's $plo and $m times $hi's $phi" \
+		num "a >= $m * b && a < $m * c" "${m2:-0}" "${plo:-1}" "${phi:-0}"
 	# the lighter level whole, or on some regions and the dearer on the
 	# rest, as far as it fits (spread_mix())
 	check "... so $lo in scale 2's place (on some regions, $hi on the rest)" grep -Eq \
@@ -703,7 +705,7 @@ if ref=$(W=320 H=240 reference "$scene"); then
 		test -z "$(compgen -G "$T/am1-scale.exr.work/p*-aa.exr")"
 	# under a budget that +A0.03 +R4 does not fit but the lighter +A0.1 +R3
 	# does (ACC_AA_FOR_SPREAD_R3), that one (spread_level, above)
-	if spread_level "$scene" r3 "+A0.1 +R3" "+A0.03 +R4" 1.25 1.25; then
+	if spread_level "$scene" r3 "+A0.1 +R3" "+A0.03 +R4"; then
 		check "... its regions file says so (scale 0, edges 3)" \
 			awk -F'\t' '$1 == 1 && $6 == 0 && $9 == 3 { f = 1 } END { exit !f }' \
 			"$T/r3.exr.work/regions.tsv"
@@ -720,7 +722,7 @@ fi
 # less than scale 2 in the same pass under the same budget (measured 2.1e-3
 # against 6.1e-3; on soft_shadows, no texture, the two erred alike).
 scene="$SC/horizon_texture.pov"
-if spread_level "$scene" floor "+A0.3 +R2" "+A0.03 +R2" 1.25 1.25; then
+if spread_level "$scene" floor "+A0.3 +R2" "+A0.03 +R2"; then
 	check "... its regions file says so (scale 0, edges 4)" \
 		awk -F'\t' '$1 == 1 && $6 == 0 && $9 == 4 { f = 1 } END { exit !f }' \
 		"$T/floor.exr.work/regions.tsv"

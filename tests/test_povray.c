@@ -1085,7 +1085,7 @@ static void test_pool_ready(void **state)
 	pov_result_release(&res);
 }
 
-/* With opts.progress, POV-Ray's progress lines as they were read: a line
+/* For a job with progress, POV-Ray's progress lines as they were read: a line
  * split across two reads is read whole, a count that falls starts again
  * (the 50 before the 10), of the lines read at once only the last is kept
  * (the 40, not the 10), and each has the time it came; without it, none.
@@ -1104,7 +1104,7 @@ static void test_pool_progress(void **state)
 	setenv("FAKE_MODE", "progress", 1);
 	fake_jobs(&job, 1, out, scene, "progress");
 	pov_pool_opts_init(&o);
-	o.progress = 1;
+	job.progress = 1;
 	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
 	assert_int_equal(res.status, POV_OK);
 	assert_int_equal(res.nprogress, 2);
@@ -1116,7 +1116,7 @@ static void test_pool_progress(void **state)
 	pov_result_release(&res);
 	assert_null(res.progress);
 
-	o.progress = 0;
+	job.progress = 0;
 	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
 	assert_int_equal(res.status, POV_OK);
 	assert_int_equal(res.nprogress, 0);
@@ -1154,7 +1154,6 @@ static void test_pool_finish(void **state)
 	fake_jobs(&job, 1, out, scene, "finish");
 	job.progress = 1;
 	pov_pool_opts_init(&o);
-	o.progress = 1;
 	o.deadline_s = 0.2;
 	o.finish_s = 0.5;
 	setenv("FAKE_MODE", "finish", 1);
