@@ -911,7 +911,8 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	double *gain = NULL;
 	struct cand *cand = NULL;
 	unsigned char *mark = NULL, *ps = NULL;
-	struct upgrade *heap = NULL;
+	struct upgrade *heap = NULL, *order = NULL;
+	unsigned char *dead = NULL;
 	struct plan_params pm = *pin;
 	const struct plan_params *p = &pm;
 	double *sat = NULL, *riders = NULL;
@@ -1028,31 +1029,63 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 		errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
 		goto out;
 	}
-	if (upgrading && !(heap = malloc(taken * sizeof(*heap)))) {
+	/*
+	 * The upgrades in the order a heap of each chosen pixel's next one
+	 * gives them, none skipped (order, made as far as an attempt asks).
+	 * An attempt takes them in that order while they fit what it may
+	 * spend; one that does not fit ends its pixel's (dead): the pixels
+	 * left give their upgrades in the same order as without the dead
+	 * ones, each pixel's next entering as its last is taken, so the
+	 * attempts need not each build a heap of their own.
+	 */
+	size_t nh = 0, norder = 0, cap_order = 0;
+	if (upgrading && (!(heap = malloc(taken * sizeof(*heap))) || !(dead = malloc(npx)))) {
 		errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
 		goto out;
 	}
+	for (size_t t = 0; upgrading && t < taken; t++) {
+		struct upgrade u;
+		size_t i = cand[t].i;
+		if (next_upgrade(p, acc, i, e[i], ps[i], smax, &u))
+			heap_push(heap, &nh, u);
+	}
 	for (int attempt = 0;; attempt++) {
 		double total = total0, spend = spend0, lambda = lambda0;
-		size_t nh = 0;
-		for (size_t t = 0; upgrading && t < taken; t++) {
-			struct upgrade u;
-			size_t i = cand[t].i;
-			if (next_upgrade(p, acc, i, e[i], ps[i], smax, &u))
-				heap_push(heap, &nh, u);
-		}
-		while (nh && total > goal && spend < upto) {
-			struct upgrade u = heap_pop(heap, &nh);
-			if (spend + u.cost > upto)
+		if (upgrading)
+			memset(dead, 0, npx);
+		for (size_t q = 0; upgrading && total > goal && spend < upto; q++) {
+			if (q == norder) {	/* the next in the heap's order */
+				if (!nh)
+					break;
+				if (norder == cap_order) {
+					size_t nc2 = cap_order ? 2 * cap_order : taken;
+					struct upgrade *o = realloc(order, nc2 * sizeof(*order));
+					if (!o) {
+						errbuf_printf(err, errlen, "out of memory planning a "
+							      "%dx%d image", w, h);
+						goto out;
+					}
+					order = o;
+					cap_order = nc2;
+				}
+				struct upgrade u = heap_pop(heap, &nh), v;
+				order[norder++] = u;
+				if (next_upgrade(p, acc, u.i, e[u.i], u.to, smax, &v))
+					heap_push(heap, &nh, v);
+			}
+			const struct upgrade *u = &order[q];
+			if (dead[u->i])
 				continue;
-			spend += u.cost;
-			total -= u.gain;
-			if (u.gain > 0.0 && u.cost / u.gain > lambda)
-				lambda = u.cost / u.gain;
-			gain[u.i] += u.gain;
-			ps[u.i] = (unsigned char)u.to;
-			if (next_upgrade(p, acc, u.i, e[u.i], u.to, smax, &u))
-				heap_push(heap, &nh, u);
+			if (spend + u->cost > upto) {
+				dead[u->i] = 1;
+				continue;
+			}
+			spend += u->cost;
+			total -= u->gain;
+			if (u->gain > 0.0 && u->cost / u->gain > lambda)
+				lambda = u->cost / u->gain;
+			gain[u->i] += u->gain;
+			ps[u->i] = (unsigned char)u->to;
 		}
 		/* riders count without a budget (riders is NULL under one):
 		 * what they would cost beyond it is cut again by value
@@ -1156,6 +1189,8 @@ out:
 	free(mark);
 	free(ps);
 	free(heap);
+	free(order);
+	free(dead);
 	free(sat);
 	free(riders);
 	if (ret)

@@ -2168,6 +2168,28 @@ static int spread_rank(int edges, int depth)
  */
 #define SPREAD_R2_SHARE 0.4
 
+/*
+ * A region's margined price at +A0.03 +R4 where it moves up to it from
+ * +A0.1 +R3 (spread_mix()), in place of SPREAD_MARGIN.  At +R4 a region's
+ * price missed its CPU the most, both ways: each region of soft_shadows,
+ * thin_geometry, Debian's granite, var_refl, noise_generator and swirlbox
+ * at 640x480 with +R4 forced (`povpress render S --budget 40 --target 1e-6
+ * --max-passes 1`, a scratch switch and print, 2026-12-05 05:40 UTC) took
+ * 0.63 to 1.96 times its price: the samples 0.50 to 0.96 times those priced
+ * (an edge pixel's four render pixels are not all subdivided), a sample
+ * 0.86 to 2.18 times the cost map's mean over the region (the edges' rays
+ * are dearer than the region's; var_refl's upper regions, 1.9 and 2.2).
+ * At SPREAD_MARGIN soft_shadows under --budget 3 took +R4 on two of four
+ * regions and lost a render at the deadline in four runs of six (relMSE
+ * 1.4e-3 to 1.6e-3, against 1.2e-4 with +A0.1 +R3 whole; 04:31 to 04:48
+ * UTC, one printed 48% done); at 2, by turns against the build before
+ * (three runs each under 2, 3 and 6 s, the six at 640x480, 05:48 to 05:54
+ * UTC, with plan_make_from()'s upgrades made once), the new build lost
+ * renders at the deadline in 1 run of 54 (noise_generator under 2 s, where
+ * no region can reach +R4), the old in 4, and under 6 s var_refl,
+ * swirlbox and noise_generator erred 0.78, 0.88 and 0.68 times as much.
+ */
+#define MIX_MARGIN_R4 2.0
 /* Region k's margined price at level l of spread_levels (NSPREAD: the
  * scale 2 it was planned as; a region of another scale as planned), price
  * as spread_am1()'s. */
@@ -2175,7 +2197,7 @@ static double level_cost(const struct plan *pl, const double *price, size_t k, i
 {
 	if (pl->regions[k].scale != 2 || l >= NSPREAD)
 		return SPREAD_MARGIN * pl->regions[k].cost;
-	return SPREAD_MARGIN * price[k * NSPREAD + l];
+	return (l ? SPREAD_MARGIN : MIX_MARGIN_R4) * price[k * NSPREAD + l];
 }
 
 /* The wall seconds pl's renders take on `slots` jobs at once, each
@@ -2216,12 +2238,9 @@ static double mix_makespan(const struct plan *pl, const double *price, int t,
  * --budget 2 at 640x480 one run in three of soft_shadows and
  * thin_geometry, two of noise_generator and every run of var_refl lost
  * renders (relMSE 1.3e-3 to 7.8e-3, against 7.6e-5 to 3.8e-4 in the
- * others' runs; 2026-12-05 03:32 to 03:41 UTC).  No region moves up to the first level,
- * +A0.03 +R4, whose 64 cells at each edge pixel make a region's price the
- * least sure: soft_shadows under --budget 3 took it on two of four
- * regions beside +A0.1 +R3 and lost a render at the deadline in four
- * runs of six (relMSE 1.4e-3 to 1.6e-3, against 1.2e-4 with +A0.1 +R3
- * whole; 04:31 to 04:48 UTC; one printed it 48% done).  Where no level
+ * others' runs; 2026-12-05 03:32 to 03:41 UTC).  A region moving up to
+ * the first level, +A0.03 +R4, is priced at MIX_MARGIN_R4, not
+ * SPREAD_MARGIN: its price is the least sure.  Where no level
  * fits (t NSPREAD), regions move up to the last level without
  * SPREAD_R2_SHARE's test: the pass then spends what it may on scale 2
  * and the moves together, not a small share of it.
@@ -2321,7 +2340,7 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 		while (t < NSPREAD &&
 		       !fits(SPREAD_MARGIN, sums[t], worst[t], pp, left))
 			t++;
-		mix = t > 1;	/* not up to +R4: see spread_mix() */
+		mix = t > 0;
 		if (t > 0 && t < NSPREAD && !(sums[t] >= SPREAD_R2_SHARE * pp->budget)) {
 			t = NSPREAD;	/* see SPREAD_R2_SHARE */
 			mix = 0;
