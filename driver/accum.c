@@ -289,7 +289,8 @@ static double spread_division(double range, const struct accum_spread *sp)
  * file without the depth column was rendered), taken
  * for edges (ACC_AA_EDGE) or else for a few pixels (ACC_AA_FEW). */
 static long merge_aa(struct image *acc, const struct image *img, int oy, const int ch[3],
-		     int f, int x0, int y0, int x1, int y1, int pass, int depth, int edges)
+		     int f, int x0, int y0, int x1, int y1, int pass, int depth, int edges,
+		     int holes)
 {
 	const struct accum_spread sp = accum_spread_render(edges, depth);
 	int cells = accum_for_spread(edges) ? sp.cells : accum_edge_cells(accum_aa_depth(depth));
@@ -307,7 +308,8 @@ static long merge_aa(struct image *acc, const struct image *img, int oy, const i
 			for (int c = 0; c < 3; c++)
 				old[c] = o[c];
 			if (!ok) {
-				accum_fold(acc, i, ACC_AA, 0, mean, m2, pass);
+				if (!holes)	/* a render's bad pixel: not again */
+					accum_fold(acc, i, ACC_AA, 0, mean, m2, pass);
 				continue;
 			}
 			/* the render's samples spread as the pixel's do; no pixel
@@ -664,7 +666,7 @@ static int grid_pixel(const struct image *acc, const struct image *img, int oy, 
 
 /* Fold a grid render (ACC_GRID_FRAME; see accum_merge_region()). */
 static long merge_grid(struct image *acc, const struct image *img, int oy, const int ch[3],
-		       int s, int x0, int y0, int x1, int y1, int pass)
+		       int s, int x0, int y0, int x1, int y1, int pass, int holes)
 {
 	struct strat st;
 	strat_begin(&st, x0, y0, x1, y1);
@@ -676,7 +678,7 @@ static long merge_grid(struct image *acc, const struct image *img, int oy, const
 			double sub[4][3], mean[3], m2[3], old[3] = { o[0], o[1], o[2] };
 			double na = o[ACC_SAMPLES];
 			int g, nq = grid_pixel(acc, img, oy, ch, s, x, y, sub, mean, m2, &g);
-			if (accum_fold(acc, i, s, nq * g, mean, m2, pass) || !nq)
+			if ((holes && nq < 4) || accum_fold(acc, i, s, nq * g, mean, m2, pass) || !nq)
 				continue;
 			count++;
 			strat_note(&st, acc, i, x, y, old, na, mean, (double)nq * g,
@@ -759,8 +761,8 @@ static int render_rgb(const struct image *img, int ch[3], char *err, size_t errl
 }
 
 static int merge_region(struct image *acc, const struct image *img, int oy, int s, int x0,
-			int y0, int x1, int y1, int pass, int depth, int edges, long *folded,
-			char *err, size_t errlen)
+			int y0, int x1, int y1, int pass, int depth, int edges, int holes,
+			long *folded, char *err, size_t errlen)
 {
 	if (folded)
 		*folded = 0;
@@ -796,8 +798,9 @@ static int merge_region(struct image *acc, const struct image *img, int oy, int 
 		return -1;
 	if (s == ACC_AA || grid) {
 		long c = s == ACC_AA
-				 ? merge_aa(acc, img, oy, ch, f, x0, y0, x1, y1, pass, depth, edges)
-				 : merge_grid(acc, img, oy, ch, s, x0, y0, x1, y1, pass);
+				 ? merge_aa(acc, img, oy, ch, f, x0, y0, x1, y1, pass, depth, edges,
+					    holes)
+				 : merge_grid(acc, img, oy, ch, s, x0, y0, x1, y1, pass, holes);
 		if (folded)
 			*folded = c;
 		return 0;
@@ -811,6 +814,8 @@ static int merge_region(struct image *acc, const struct image *img, int oy, int 
 		for (int x = x0; x <= x1; x++) {
 			double mean[3], m2[3], q[4][3];
 			int n = scaled_pixel(img, oy, ch, s, x, y, mean, m2, q);
+			if (holes && n < s * s)
+				continue;
 			size_t i = (size_t)y * acc->w + x;
 			const float *o = acc->px + i * ACC_NCH;
 			double old[3] = { o[0], o[1], o[2] }, na = o[ACC_SAMPLES];
@@ -875,7 +880,7 @@ int accum_merge_region(struct image *acc, const struct image *img, int oy, int s
 		       int y0, int x1, int y1, int pass, long *folded, char *err,
 		       size_t errlen)
 {
-	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, 0, 0, folded, err, errlen);
+	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, 0, 0, 0, folded, err, errlen);
 }
 
 /* Whether depth is not one an antialiased render in scale 2's place may
@@ -894,8 +899,18 @@ int accum_merge_aa_region(struct image *acc, const struct image *img, int oy, in
 {
 	if (bad_depth(depth, err, errlen))
 		return -1;
-	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, depth, edges, folded, err,
+	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, depth, edges, 0, folded, err,
 			    errlen);
+}
+
+int accum_merge_partial(struct image *acc, const struct image *img, int oy, int s, int depth,
+			int edges, int x0, int y0, int x1, int y1, int pass, long *folded,
+			char *err, size_t errlen)
+{
+	if (s == ACC_AA && bad_depth(depth, err, errlen))
+		return -1;
+	return merge_region(acc, img, oy, s, x0, y0, x1, y1, pass, s == ACC_AA ? depth : 0,
+			    s == ACC_AA ? edges : 0, 1, folded, err, errlen);
 }
 
 static int merge_file(struct image *acc, const char *path, int s, int x0, int y0, int x1,
@@ -913,7 +928,7 @@ static int merge_file(struct image *acc, const char *path, int s, int x0, int y0
 		f = render_frame(s, w, acc->w);
 	}
 	int rc = image_read_exr_rows(path, y0 * f, (y1 + 1) * f - 1, &img, &oy, err, errlen) ||
-		 merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, depth, edges, folded, err,
+		 merge_region(acc, &img, oy, s, x0, y0, x1, y1, pass, depth, edges, 0, folded, err,
 			      errlen);
 	image_release(&img);
 	return rc ? -1 : 0;

@@ -443,6 +443,21 @@ int accum_merge_aa_file(struct image *acc, const char *path, int s, int depth, i
 			int x0, int y0, int x1, int y1, int pass, long *folded, char *err,
 			size_t errlen);
 
+/*
+ * accum_merge_region() (depth and edges ignored) or accum_merge_aa_region()
+ * (s ACC_AA) of a render that was stopped before it ended: img holds the
+ * pixels it finished (povstate.h) and NaN where it did not get to, and a
+ * pixel any of whose render pixels is not finite is left as it was, its
+ * scale not marked (a whole render's bad pixel is marked as having had the
+ * scale, so that it is not planned again).  POV-Ray's blocks are 32 render
+ * pixels a side from the region's corner, so a pixel of a render at 1, 2,
+ * 4, 8 or 16 times the image's size is rendered whole or not at all (with
+ * the user's +BS, a pixel a block's edge cuts is left out).
+ */
+int accum_merge_partial(struct image *acc, const struct image *img, int oy, int s, int depth,
+			int edges, int x0, int y0, int x1, int y1, int pass, long *folded,
+			char *err, size_t errlen);
+
 /* What pixel i's relative errors are relative to: the mean over R, G, B
  * of value^2 + 0.01, the value being fit (the regression's, where finite;
  * fit may be NULL) or else the samples' mean. */

@@ -71,6 +71,8 @@
 
 #include <stddef.h>
 
+#include "driver/image.h"
+
 /* A pixel rectangle, 0-based and inclusive: columns x0..x1, rows y0..y1. */
 struct pov_region {
 	int x0, y0, x1, y1;
@@ -110,6 +112,10 @@ struct pov_job {
 					 * "Rendered N of M pixels" line as each
 					 * block ends, which the pool keeps
 					 * (struct pov_result's progress) */
+	int salvage;			/* stopped at the pool's deadline, the
+					 * blocks it finished are read from its
+					 * render state file (povstate.h) into
+					 * struct pov_result's partial */
 };
 
 /* What POV-Ray's statistics report about one run. */
@@ -249,6 +255,13 @@ struct pov_result {
 	struct pov_progress *progress;
 	size_t nprogress;
 	long progress_total;		/* their M */
+	/* For a job with salvage stopped at the deadline (POV_CANCELLED): the
+	 * pixels of its frame's rows (its region's, or all) that it finished,
+	 * NaN where it did not, the image's first row partial_oy, and how many
+	 * (pov_state_read()); a zeroed image when none; owned */
+	struct image partial;
+	int partial_oy;
+	long partial_pixels;
 };
 
 /* One "Rendered N of M pixels" line of a render: when it was read, and N. */

@@ -249,6 +249,10 @@ struct pass_rec {
 				 * or a pass resumed; not in progress.txt) */
 	double analysis_s;
 	int prelaunched;	/* regions taken from renders started early */
+	int stopped;		/* region renders stopped at the budget's end (not
+				 * in progress.txt) */
+	long kept;		/* their pixels folded in from the blocks they
+				 * finished (not in progress.txt) */
 };
 
 struct run {
@@ -516,8 +520,10 @@ static void pass_job(const struct run *r, int pass, struct pov_job *job, const c
 	job->defines = pd;
 	job->ndefines = 1;
 	/* under a budget, how far a render stopped at its end got, and
-	 * whether it is about to finish (pov_pool_opts' finish_s) */
+	 * whether it is about to finish (pov_pool_opts' finish_s); the
+	 * blocks it finished, kept */
 	job->progress = r->budget > 0.0;
+	job->salvage = r->budget > 0.0;
 }
 
 static void on_done(void *arg, size_t index, const struct pov_result *res)
@@ -808,8 +814,9 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 			fprintf(f, "\"planned_relmse\": %.6g, ", p->planned_relmse);
 		else
 			fputs("\"planned_relmse\": null, ", f);
-		fprintf(f, "\"analysis_s\": %.3f, \"prelaunched\": %d}%s\n", p->analysis_s,
-			p->prelaunched, k + 1 < r->npasses ? "," : "");
+		fprintf(f, "\"analysis_s\": %.3f, \"prelaunched\": %d, \"stopped\": %d, "
+			"\"kept\": %ld}%s\n", p->analysis_s, p->prelaunched, p->stopped, p->kept,
+			k + 1 < r->npasses ? "," : "");
 		tw += p->wall_s;
 		tc += p->cpu_s;
 		td += p->driver_cpu_s;
@@ -2651,7 +2658,8 @@ enum { PASS_STOP = 2 };
  * How long past its deadline a pass's region render that will have
  * rendered its pixels by then is left to end (pov_pool_opts' finish_s),
  * at most FINISH_SHARE of the budget.  Stopped at the deadline, a render
- * loses all it did: Debian's textures/finishes/var_refl at 640x480 under
+ * keeps only the blocks it finished (pass_job()'s salvage; before that it
+ * lost all it did): Debian's textures/finishes/var_refl at 640x480 under
  * --budget 2, one run in four, lost a render that had rendered all its
  * pixels and was writing its image (its progress lines, 2026-12-05):
  * estimated relMSE 9.0e-3, the others 2.6e-3 to 2.8e-3.  POV-Ray
@@ -2835,7 +2843,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		 * of glossy floor costs more per sample than the frame's
 		 * average: glossy_reflection at --budget 8 ended at 10.9 s):
 		 * regions still rendering when only the analysis's time is
-		 * left are stopped, and what they did is lost; but those
+		 * left are stopped, the blocks they finished kept (the rest
+		 * is lost); but those
 		 * that will have rendered their pixels within half of FINISH_S
 		 * (of FINISH_SHARE of the budget at most) are left that long */
 		po.deadline_s = deadline_in(r, reserve);
@@ -2866,6 +2875,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		goto out;
 	p.pass = pass;
 	int stopped = 0;
+	long kept = 0;	/* the stopped renders' pixels folded in */
 	char how_far[128] = "";
 	size_t at_far = 0;
 	for (size_t k = 0; k < n; k++) {
@@ -2887,6 +2897,23 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 					at_far += (size_t)snprintf(how_far + at_far,
 								   sizeof(how_far) - at_far, "%s%s",
 								   at_far ? ", " : "", one);
+				/* the blocks it finished, folded in */
+				long folded = 0;
+				if (q->partial_pixels &&
+				    accum_merge_partial(&r->acc, &q->partial, q->partial_oy, s,
+							g->depth, g->edges, g->x0, g->y0, g->x1,
+							g->y1, pass, &folded, err, errlen)) {
+					fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: "
+						"the blocks it finished: %s\n", pass, g->x0, g->y0,
+						g->x1, g->y1, err);
+					folded = 0;
+				}
+				kept += folded;
+				p.pixels += folded;
+				if (folded) {
+					const int fr = g->frame > 0 ? g->frame : 1;
+					p.samples += (double)folded * (s != ACC_AA ? s * s : fr * fr);
+				}
 			}
 			if (results[k].status != POV_CANCELLED) {
 				p.failed++;
@@ -2915,9 +2942,12 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 			unlink(outs[k]);
 	}
 	learn_costs(r, &pp, &pl, results);
+	p.stopped = stopped;
+	p.kept = kept;
 	if (stopped) {
-		progress(r, "pass %d: %d of %zu region renders stopped at the budget's end, "
-			 "their samples lost (done: %s of their pixels)", pass, stopped, n, how_far);
+		progress(r, "pass %d: %d of %zu region renders stopped at the budget's end "
+			 "(done: %s of their pixels; %ld pixels kept)", pass, stopped, n, how_far,
+			 kept);
 		progress_end(r);
 	}
 	/* what a region render waits on besides its CPU, for the budget's

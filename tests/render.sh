@@ -1011,12 +1011,18 @@ fi
 # the reserve, and nothing was stopped: one make check of five here.)
 t0=$EPOCHREALTIME
 "$PP" render "$SC/media.pov" -o "$T/dl.exr" -W 480 -H 360 --budget 4 --target 1e-6 \
-	--cost-sample 1e-9 --prelaunch off --max-passes 1 --workdir "$T/dl work" -v 2>"$T/dl.err"
+	--cost-sample 1e-9 --prelaunch off --max-passes 1 --workdir "$T/dl work" -v \
+	--report "$T/dl.json" 2>"$T/dl.err"
 rc=$?
 dt=$(awk -v a="$t0" -v b="$EPOCHREALTIME" 'BEGIN { printf "%.2f", b - a }')
 check "budget deadline: a run whose pass is planned as free succeeds" test $rc -eq 0
 check "... its region renders are stopped at the budget's end" \
 	grep -q "stopped at the budget's end" "$T/dl.err"
+# the blocks the stopped render finished are folded in from its state file
+dlk=$(sed -n "s/.*stopped at the budget's end (done: .*; \([0-9]*\) pixels kept)/\1/p" "$T/dl.err")
+check "... the pixels it finished are kept (${dlk:-none})" num 'a >= 64' "${dlk:-0}"
+check "... and the pass counts them" \
+	grep -q "\"pass\": 1, .*\"pixels\": ${dlk:-x}, " "$T/dl.json"
 check "... and it ends within the 4 s budget ($dt s)" num 'a <= 4.3' "$dt"
 check "... the output is a complete image" valid_exr "$T/dl.exr"
 check "... no POV-Ray child left" no_povray_left "$T/dl work"

@@ -259,6 +259,96 @@ static void expect_fold(const float *b, double nb, const double m[3], const doub
 }
 
 /*
+ * accum_merge_partial: a render stopped before it ended, its pixels not
+ * rendered NaN.  A pixel with a render pixel missing is left as it was,
+ * its scale not marked (accum_merge_region marks a whole render's bad
+ * pixel, not to plan it again); the others fold as from the whole render
+ * (at scale 2 but for the quadrant twist's neighbourhood, diff; antialiased
+ * in scale 2's place, whole).
+ */
+static void test_merge_partial(void **state)
+{
+	const int W = 8, H = 4;
+	struct image acc, whole, cut, aa;
+	char err[256];
+	long folded = -1;
+
+	(void)state;
+	make_acc(&acc, W, H, base_value);
+	make_render(&whole, 2 * W, 0, 2 * H, 5);
+	make_render(&cut, 2 * W, 0, 2 * H, 5);
+	/* pixel (2, 1) not rendered, and one render pixel of (5, 2) */
+	for (int j = 0; j < 2; j++)
+		for (int l = 0; l < 2; l++)
+			for (int c = 0; c < 3; c++)
+				cut.px[((size_t)(2 + j) * cut.w + 4 + l) * 3 + c] = NAN;
+	cut.px[((size_t)5 * cut.w + 11) * 3 + 0] = NAN;
+	const size_t npx = (size_t)W * H, bytes = npx * ACC_NCH * sizeof(float);
+	const size_t hole[2] = { 1 * (size_t)W + 2, 2 * (size_t)W + 5 };
+	for (int mode = 0; mode < 2; mode++) {
+		/* mode 0: scale 2; mode 1: antialiased in scale 2's place, the
+		 * render at twice the size taken for spread error */
+		const int s = mode ? ACC_AA : 2, depth = mode ? 3 : 0,
+			  edges = mode ? ACC_AA_FOR_SPREAD : 0;
+		float *ref = malloc(bytes), *part = malloc(bytes), *marked = malloc(bytes);
+		assert_non_null(ref);
+		assert_non_null(part);
+		assert_non_null(marked);
+		struct image a = acc;
+		a.px = ref;
+		memcpy(ref, acc.px, bytes);
+		if (mode)
+			assert_int_equal(accum_merge_aa_region(&a, &whole, 0, s, depth, edges, 0, 0,
+							       W - 1, H - 1, 1, &folded, err,
+							       sizeof(err)), 0);
+		else
+			assert_int_equal(accum_merge_region(&a, &whole, 0, s, 0, 0, W - 1, H - 1, 1,
+							    &folded, err, sizeof(err)), 0);
+		assert_int_equal(folded, (long)npx);
+		a.px = part;
+		memcpy(part, acc.px, bytes);
+		assert_int_equal(accum_merge_partial(&a, &cut, 0, s, depth, edges, 0, 0, W - 1,
+						     H - 1, 1, &folded, err, sizeof(err)), 0);
+		assert_int_equal(folded, (long)npx - 2);
+		for (size_t i = 0; i < npx; i++) {
+			if (i == hole[0] || i == hole[1]) {
+				assert_memory_equal(part + i * ACC_NCH, acc.px + i * ACC_NCH,
+						    ACC_NCH * sizeof(float));
+				assert_false(accum_has_scale(&a, i, s));
+				continue;
+			}
+			assert_true(accum_has_scale(&a, i, s));
+			for (int c = 0; c < ACC_NCH; c++)
+				if (c != ACC_DIFF || mode)
+					assert_true(part[i * ACC_NCH + c] == ref[i * ACC_NCH + c]);
+		}
+		/* the whole-render merge of the same image marks the hole */
+		a.px = marked;
+		memcpy(marked, acc.px, bytes);
+		if (mode)
+			assert_int_equal(accum_merge_aa_region(&a, &cut, 0, s, depth, edges, 0, 0,
+							       W - 1, H - 1, 1, &folded, err,
+							       sizeof(err)), 0);
+		else
+			assert_int_equal(accum_merge_region(&a, &cut, 0, s, 0, 0, W - 1, H - 1, 1,
+							    &folded, err, sizeof(err)), 0);
+		assert_true(accum_has_scale(&a, hole[0], s));
+		free(ref);
+		free(part);
+		free(marked);
+	}
+	/* a bad depth is an error, as for a whole render */
+	make_render(&aa, 2 * W, 0, 2 * H, 6);
+	assert_int_equal(accum_merge_partial(&acc, &aa, 0, ACC_AA, ACC_AA_DEPTH + 1, 2, 0, 0,
+					     W - 1, H - 1, 1, &folded, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "depth"));
+	image_release(&aa);
+	image_release(&cut);
+	image_release(&whole);
+	image_release(&acc);
+}
+
+/*
  * accum_merge_region of grid renders, twice the image's width: 2 x 2
  * sub-pixels of (s/2)^2 + 1 samples, less the centre one where the pixel
  * has scale 2 (which it repeats), replaced by the pixel's mean (their mean, their spread and the
@@ -2721,6 +2811,7 @@ int main(void)
 		cmocka_unit_test(test_merge_aa),
 		cmocka_unit_test(test_merge_aa_edges),
 		cmocka_unit_test(test_merge_grid),
+		cmocka_unit_test(test_merge_partial),
 		cmocka_unit_test(test_merge_stratified),
 		cmocka_unit_test(test_accum_read),
 		cmocka_unit_test(test_read_rows),

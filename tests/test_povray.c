@@ -20,6 +20,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,6 +33,7 @@
 
 #include "driver/image.h"
 #include "driver/povray.h"
+#include "driver/povstate.h"
 #include "tests/testutil.h"
 
 #define DATA "tests/data/povray/"
@@ -1306,6 +1308,138 @@ static void test_pool_error_messages(void **state)
 	}
 }
 
+/* ---- render state files ------------------------------------------------- */
+
+/* A growing byte buffer for a state file made by hand. */
+struct bytes {
+	unsigned char *p;
+	size_t n, cap;
+};
+
+static void put(struct bytes *b, const void *v, size_t n)
+{
+	if (b->n + n > b->cap) {
+		b->cap = 2 * (b->n + n);
+		b->p = realloc(b->p, b->cap);
+		assert_non_null(b->p);
+	}
+	memcpy(b->p + b->n, v, n);
+	b->n += n;
+}
+
+static void put32(struct bytes *b, uint32_t v)
+{
+	unsigned char q[4] = { (unsigned char)(v >> 24), (unsigned char)(v >> 16),
+			       (unsigned char)(v >> 8), (unsigned char)v };
+	put(b, q, 4);
+}
+
+/* A block's message as POV-Ray writes it: its pixels (5 floats each, the
+ * colour value(x, y, c) then filter and transmit) over columns l..r, rows
+ * t..b, count the floats it claims (0: the right count). */
+static void put_block(struct bytes *b, int l, int t, int r, int bt, uint32_t count)
+{
+	const uint32_t n = (uint32_t)((r - l + 1) * (bt - t + 1) * 5);
+	put(b, "POVRAYMS", 8);
+	put32(b, 0x370);
+	put32(b, 20 + 4 * n);
+	put(b, "RAWSOBJE\0\0\0\x0dOCLATYPE\0\0\0\x04PixD", 28);
+	put(b, "PBloVFL4", 8);
+	put32(b, count ? count : n);
+	for (int y = t; y <= bt; y++)
+		for (int x = l; x <= r; x++)
+			for (int c = 0; c < 5; c++) {
+				float f = c < 3 ? (float)(x + 100 * y + 0.25 * c) : 0.0f;
+				uint32_t u;
+				memcpy(&u, &f, 4);
+				put32(b, u);
+			}
+	static const char *const key[4] = { "LeftINT4", "Top INT4", "RighINT4", "BottINT4" };
+	const int v[4] = { l, t, r, bt };
+	put(b, "PiIdINT4", 8);
+	put32(b, 4);
+	put32(b, 7);
+	for (int k = 0; k < 4; k++) {
+		put(b, key[k], 8);
+		put32(b, 4);
+		put32(b, (uint32_t)v[k]);
+	}
+}
+
+/*
+ * pov_state_parse: the blocks of a render state file, each pixel once, in
+ * the rows asked for; a block cut short at the end, one whose count does not
+ * match its size and one outside the frame left out; a file that is not a
+ * state file an error; pov_state_path() names it as POV-Ray does.
+ */
+static void test_state_parse(void **state)
+{
+	struct bytes b = { 0 };
+	struct image img;
+	int oy;
+	long px;
+	char err[256], path[64];
+
+	(void)state;
+	static const char head[] = "POV-Ray Render State File\0\0\0" "0001 options...";
+	put(&b, head, sizeof(head) - 1);
+	put_block(&b, 0, 0, 3, 1, 0);	/* 4 x 2 */
+	put_block(&b, 4, 0, 7, 1, 0);
+	put_block(&b, 4, 0, 7, 1, 0);	/* again: counted once */
+	put_block(&b, 0, 2, 3, 3, 41);	/* a wrong count */
+	put_block(&b, 8, 2, 11, 3, 0);	/* outside an 8-wide frame */
+	put_block(&b, 0, 4, 3, 5, 0);
+	put_block(&b, 4, 4, 7, 5, 0);
+	const size_t cut = b.n - 30;	/* the last block cut short */
+	assert_int_equal(pov_state_parse(b.p, cut, "s", 8, 6, 0, 5, &img, &oy, &px, err,
+					 sizeof(err)), 0);
+	assert_int_equal(oy, 0);
+	assert_int_equal(img.w, 8);
+	assert_int_equal(img.h, 6);
+	assert_int_equal(px, 8 + 8 + 8);
+	for (int y = 0; y < 6; y++)
+		for (int x = 0; x < 8; x++) {
+			const float *q = img.px + ((size_t)y * 8 + x) * 3;
+			const int have = y < 2 || (y >= 4 && x < 4);
+			for (int c = 0; c < 3; c++)
+				if (have)
+					assert_true(q[c] == (float)(x + 100 * y + 0.25 * c));
+				else
+					assert_true(isnan(q[c]));
+		}
+	image_release(&img);
+	/* rows 1 to 4 only; the whole last block now */
+	assert_int_equal(pov_state_parse(b.p, b.n, "s", 8, 6, 1, 4, &img, &oy, &px, err,
+					 sizeof(err)), 0);
+	assert_int_equal(oy, 1);
+	assert_int_equal(img.h, 4);
+	assert_int_equal(px, 8 + 8);
+	assert_true(img.px[((size_t)3 * 8 + 6) * 3 + 1] == (float)(6 + 400 + 0.25));
+	assert_true(isnan(img.px[((size_t)1 * 8 + 0) * 3]));
+	image_release(&img);
+	/* no whole block: no pixels, not an error */
+	assert_int_equal(pov_state_parse(b.p, 60, "s", 8, 6, 0, 5, &img, &oy, &px, err,
+					 sizeof(err)), 0);
+	assert_int_equal(px, 0);
+	image_release(&img);
+	/* not a state file; rows outside the frame */
+	assert_int_equal(pov_state_parse((const unsigned char *)"EXR v2", 6, "x.exr", 8, 6, 0, 5,
+					 &img, &oy, &px, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "'x.exr' is not a POV-Ray render state file"));
+	assert_null(img.px);
+	assert_int_equal(pov_state_parse(b.p, b.n, "s", 8, 6, 2, 6, &img, &oy, &px, err,
+					 sizeof(err)), -1);
+	assert_int_equal(pov_state_read("/nonexistent/a.pov-state", 8, 6, 0, 5, &img, &oy, &px,
+					err, sizeof(err)), -1);
+	assert_non_null(strstr(err, "/nonexistent/a.pov-state"));
+	assert_int_equal(pov_state_path("dir.v2/p01-r003-aa.exr", path, sizeof(path)), 0);
+	assert_string_equal(path, "dir.v2/p01-r003-aa.pov-state");
+	assert_int_equal(pov_state_path("dir.v2/noext", path, sizeof(path)), 0);
+	assert_string_equal(path, "dir.v2/noext.pov-state");
+	assert_int_equal(pov_state_path("dir/long-name.exr", path, 8), -1);
+	free(b.p);
+}
+
 /* ---- the pool with the real povray ---------------------------------------- */
 
 static void assert_pixel(const struct image *img, int x, int y, int nonzero)
@@ -1412,6 +1546,106 @@ static void test_render_region(void **state)
 		image_release(&img);
 	}
 	release_all(res, 2);
+}
+
+/*
+ * A render stopped at the pool's deadline with salvage: the blocks it
+ * finished come back in its result, as a render of them alone has them
+ * (within the halves of POV-Ray's OpenEXR output), NaN elsewhere, and its
+ * state file is gone; without salvage, none.
+ */
+static void test_render_salvage(void **state)
+{
+	static const char slow[] =
+		"#version 3.7;\n"
+		"global_settings { assumed_gamma 1.0 }\n"
+		"camera { location <0, 3, -2.5> look_at <0, 0.3, 0> }\n"
+		"light_source { <3, 5, -3> rgb 1 area_light <2, 0, 0>, <0, 0, 2>, 10, 10 jitter }\n"
+		"plane { y, 0 pigment { checker rgb 1 rgb 0.2 scale 0.3 } }\n"
+		"sphere { <0, 0.6, 0>, 0.6 pigment { rgb <1, 0.5, 0.2> } finish { reflection 0.3 } }\n";
+	static const char *const aa[] = { "+AM1", "+A0.0", "+R3" };
+	/* about 3.4 s of tracing on one thread; the first two blocks 0.17 s */
+	const struct pov_region r = { 16, 16, 239, 175 }, first = { 16, 16, 79, 47 };
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], part[PATH_MAX], err[512];
+	struct pov_job job;
+	struct pov_result res;
+	struct pov_pool_opts o;
+	struct image img = { 0 };
+	int oy;
+
+	(void)state;
+	mkdir_p(scratch(dir, sizeof(dir), "salvage"));
+	write_file(scratch(scene, sizeof(scene), "salvage/slow.pov"), slow);
+	memset(&job, 0, sizeof(job));
+	job.scene = scene;
+	job.output = scratch(out, sizeof(out), "salvage/r.exr");
+	job.width = 256;
+	job.height = 192;
+	job.region = &r;
+	job.threads = 1;
+	job.extra = aa;
+	job.nextra = 3;
+	job.salvage = 1;
+	pov_pool_opts_init(&o);
+	o.max_jobs = 1;
+	o.deadline_s = 2.0;
+	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
+	assert_int_equal(res.status, POV_CANCELLED);
+	const long all = (long)(r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1);
+	if (!(res.partial_pixels >= 2 * 32 * 32 && res.partial_pixels < all))
+		fail_msg("%ld pixels kept of %ld", res.partial_pixels, all);
+	assert_int_equal(res.partial.w, 256);
+	assert_int_equal(res.partial_oy, r.y0);
+	assert_int_equal(res.partial.h, r.y1 - r.y0 + 1);
+	assert_false(exists(out));
+	assert_int_equal(count_entries(dir, "pov-state"), 0);
+	/* the first two blocks, rendered alone */
+	job.output = scratch(part, sizeof(part), "salvage/first.exr");
+	job.region = &first;
+	job.salvage = 0;
+	o.deadline_s = 0.0;
+	struct pov_result whole;
+	assert_int_equal(pov_pool_run(&job, 1, &o, &whole, err, sizeof(err)), 0);
+	assert_int_equal(whole.status, POV_OK);
+	assert_int_equal(image_read_exr_rows(part, first.y0, first.y1, &img, &oy, err, sizeof(err)),
+			 0);
+	long n = 0, checked = 0;
+	for (int y = 0; y < res.partial.h; y++)
+		for (int x = 0; x < res.partial.w; x++) {
+			const float *q = res.partial.px + ((size_t)y * res.partial.w + x) * 3;
+			const int Y = y + res.partial_oy;
+			if (isnan(q[0])) {
+				assert_true(isnan(q[1]) && isnan(q[2]));
+				continue;
+			}
+			n++;
+			assert_true(x >= r.x0 && x <= r.x1);
+			if (x > first.x1 || Y > first.y1)
+				continue;
+			for (int c = 0; c < 3; c++) {
+				const float v = img.px[((size_t)(Y - oy) * img.w + x) * img.nch +
+						       image_channel(&img, c == 0 ? "R" : c == 1 ? "G" : "B")];
+				if (!(fabsf(q[c] - v) <= 1e-3f * fabsf(v) + 1e-4f))
+					fail_msg("pixel (%d, %d) channel %d: %g kept, %g rendered", x, Y,
+						 c, q[c], v);
+			}
+			checked++;
+		}
+	assert_int_equal(n, res.partial_pixels);
+	assert_int_equal(checked, 2 * 32 * 32);
+	image_release(&img);
+	pov_result_release(&whole);
+	pov_result_release(&res);
+	/* without salvage, nothing is kept */
+	job.output = out;
+	job.region = &r;
+	o.deadline_s = 1.5;
+	assert_int_equal(pov_pool_run(&job, 1, &o, &res, err, sizeof(err)), 0);
+	assert_int_equal(res.status, POV_CANCELLED);
+	assert_int_equal(res.partial_pixels, 0);
+	assert_null(res.partial.px);
+	assert_int_equal(count_entries(dir, "pov-state"), 0);
+	pov_result_release(&res);
 }
 
 static void test_render_parse_error(void **state)
@@ -1726,10 +1960,12 @@ int main(void)
 		cmocka_unit_test(test_pool_ready),
 		cmocka_unit_test(test_pool_crash_retry_and_no_output),
 		cmocka_unit_test(test_pool_error_messages),
+		cmocka_unit_test(test_state_parse),
 		cmocka_unit_test(test_render_awkward_paths),
 		cmocka_unit_test(test_render_region),
 		cmocka_unit_test(test_prelaunch),
 		cmocka_unit_test(test_render_parse_error),
+		cmocka_unit_test(test_render_salvage),
 		cmocka_unit_test(test_timeout_kills),
 		cmocka_unit_test(test_pool_deadline),
 		cmocka_unit_test(test_pool_progress),
