@@ -1646,6 +1646,7 @@ static int finish(struct pjob *j, const struct pov_pool_opts *opts, double t0,
 
 		report(res, POV_CANCELLED, "povray stopped by %s rendering '%s'",
 		       sig ? signame(sig) : "an interruption", j->cmd.output);
+		salvage(j, res);
 	} else if (j->stop == STOP_DEADLINE) {
 		report(res, POV_CANCELLED, "povray stopped past the deadline (%g s) rendering '%s'",
 		       opts->deadline_s, j->cmd.output);

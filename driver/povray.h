@@ -112,10 +112,11 @@ struct pov_job {
 					 * "Rendered N of M pixels" line as each
 					 * block ends, which the pool keeps
 					 * (struct pov_result's progress) */
-	int salvage;			/* stopped at the pool's deadline, the
-					 * blocks it finished are read from its
-					 * render state file (povstate.h) into
-					 * struct pov_result's partial */
+	int salvage;			/* stopped at the pool's deadline or by
+					 * an interruption, the blocks it
+					 * finished are read from its render
+					 * state file (povstate.h) into struct
+					 * pov_result's partial */
 };
 
 /* What POV-Ray's statistics report about one run. */
@@ -255,10 +256,11 @@ struct pov_result {
 	struct pov_progress *progress;
 	size_t nprogress;
 	long progress_total;		/* their M */
-	/* For a job with salvage stopped at the deadline (POV_CANCELLED): the
-	 * pixels of its frame's rows (its region's, or all) that it finished,
-	 * NaN where it did not, the image's first row partial_oy, and how many
-	 * (pov_state_read()); a zeroed image when none; owned */
+	/* For a job with salvage stopped at the deadline or by an interruption
+	 * (POV_CANCELLED): the pixels of its frame's rows (its region's, or
+	 * all) that it finished, NaN where it did not, the image's first row
+	 * partial_oy, and how many (pov_state_read()); a zeroed image when
+	 * none; owned */
 	struct image partial;
 	int partial_oy;
 	long partial_pixels;

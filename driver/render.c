@@ -520,10 +520,11 @@ static void pass_job(const struct run *r, int pass, struct pov_job *job, const c
 	job->defines = pd;
 	job->ndefines = 1;
 	/* under a budget, how far a render stopped at its end got, and
-	 * whether it is about to finish (pov_pool_opts' finish_s); the
-	 * blocks it finished, kept */
+	 * whether it is about to finish (pov_pool_opts' finish_s); stopped
+	 * at the deadline or by an interruption, the blocks it finished,
+	 * kept */
 	job->progress = r->budget > 0.0;
-	job->salvage = r->budget > 0.0;
+	job->salvage = 1;
 }
 
 static void on_done(void *arg, size_t index, const struct pov_result *res)
@@ -2884,9 +2885,9 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		p.cpu_s += results[k].cpu_s;
 		p.invocations += results[k].attempts;
 		if (results[k].status != POV_OK) {
-			if (results[k].status == POV_CANCELLED && rc != POV_INTERRUPTED) {
+			const struct pov_result *q = &results[k];
+			if (q->status == POV_CANCELLED && rc != POV_INTERRUPTED) {
 				stopped++;	/* the budget's deadline */
-				const struct pov_result *q = &results[k];
 				const double f = q->nprogress && q->progress_total > 0
 					? (double)q->progress[q->nprogress - 1].done /
 						  (double)q->progress_total : 0.0;
@@ -2897,23 +2898,24 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 					at_far += (size_t)snprintf(how_far + at_far,
 								   sizeof(how_far) - at_far, "%s%s",
 								   at_far ? ", " : "", one);
-				/* the blocks it finished, folded in */
-				long folded = 0;
-				if (q->partial_pixels &&
-				    accum_merge_partial(&r->acc, &q->partial, q->partial_oy, s,
-							g->depth, g->edges, g->x0, g->y0, g->x1,
-							g->y1, pass, &folded, err, errlen)) {
-					fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: "
-						"the blocks it finished: %s\n", pass, g->x0, g->y0,
-						g->x1, g->y1, err);
-					folded = 0;
-				}
-				kept += folded;
-				p.pixels += folded;
-				if (folded) {
-					const int fr = g->frame > 0 ? g->frame : 1;
-					p.samples += (double)folded * (s != ACC_AA ? s * s : fr * fr);
-				}
+			}
+			/* stopped at the deadline or by an interruption: the
+			 * blocks it finished, folded in */
+			long folded = 0;
+			if (q->status == POV_CANCELLED && q->partial_pixels &&
+			    accum_merge_partial(&r->acc, &q->partial, q->partial_oy, s, g->depth,
+						g->edges, g->x0, g->y0, g->x1, g->y1, pass, &folded,
+						err, errlen)) {
+				fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: "
+					"the blocks it finished: %s\n", pass, g->x0, g->y0, g->x1,
+					g->y1, err);
+				folded = 0;
+			}
+			kept += folded;
+			p.pixels += folded;
+			if (folded) {
+				const int fr = g->frame > 0 ? g->frame : 1;
+				p.samples += (double)folded * (s != ACC_AA ? s * s : fr * fr);
 			}
 			if (results[k].status != POV_CANCELLED) {
 				p.failed++;
@@ -2944,6 +2946,11 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	learn_costs(r, &pp, &pl, results);
 	p.stopped = stopped;
 	p.kept = kept;
+	if (rc == POV_INTERRUPTED && kept) {
+		progress(r, "pass %d: interrupted, %ld pixels kept from the blocks its stopped "
+			 "renders had finished", pass, kept);
+		progress_end(r);
+	}
 	if (stopped) {
 		progress(r, "pass %d: %d of %zu region renders stopped at the budget's end "
 			 "(done: %s of their pixels; %ld pixels kept)", pass, stopped, n, how_far,

@@ -1554,18 +1554,35 @@ static void test_render_region(void **state)
  * (within the halves of POV-Ray's OpenEXR output), NaN elsewhere, and its
  * state file is gone; without salvage, none.
  */
+/* A scene of about 3.4 s of tracing on one thread in salvage_region at
+ * 256x192 with salvage_aa, its first two blocks 0.17 s (2026-12-05). */
+static const char salvage_scene[] =
+	"#version 3.7;\n"
+	"global_settings { assumed_gamma 1.0 }\n"
+	"camera { location <0, 3, -2.5> look_at <0, 0.3, 0> }\n"
+	"light_source { <3, 5, -3> rgb 1 area_light <2, 0, 0>, <0, 0, 2>, 10, 10 jitter }\n"
+	"plane { y, 0 pigment { checker rgb 1 rgb 0.2 scale 0.3 } }\n"
+	"sphere { <0, 0.6, 0>, 0.6 pigment { rgb <1, 0.5, 0.2> } finish { reflection 0.3 } }\n";
+static const char *const salvage_aa[] = { "+AM1", "+A0.0", "+R3" };
+static const struct pov_region salvage_region = { 16, 16, 239, 175 };
+
+static void salvage_job(struct pov_job *job, const char *scene, const char *out)
+{
+	memset(job, 0, sizeof(*job));
+	job->scene = scene;
+	job->output = out;
+	job->width = 256;
+	job->height = 192;
+	job->region = &salvage_region;
+	job->threads = 1;
+	job->extra = salvage_aa;
+	job->nextra = 3;
+	job->salvage = 1;
+}
+
 static void test_render_salvage(void **state)
 {
-	static const char slow[] =
-		"#version 3.7;\n"
-		"global_settings { assumed_gamma 1.0 }\n"
-		"camera { location <0, 3, -2.5> look_at <0, 0.3, 0> }\n"
-		"light_source { <3, 5, -3> rgb 1 area_light <2, 0, 0>, <0, 0, 2>, 10, 10 jitter }\n"
-		"plane { y, 0 pigment { checker rgb 1 rgb 0.2 scale 0.3 } }\n"
-		"sphere { <0, 0.6, 0>, 0.6 pigment { rgb <1, 0.5, 0.2> } finish { reflection 0.3 } }\n";
-	static const char *const aa[] = { "+AM1", "+A0.0", "+R3" };
-	/* about 3.4 s of tracing on one thread; the first two blocks 0.17 s */
-	const struct pov_region r = { 16, 16, 239, 175 }, first = { 16, 16, 79, 47 };
+	const struct pov_region r = salvage_region, first = { 16, 16, 79, 47 };
 	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], part[PATH_MAX], err[512];
 	struct pov_job job;
 	struct pov_result res;
@@ -1575,17 +1592,8 @@ static void test_render_salvage(void **state)
 
 	(void)state;
 	mkdir_p(scratch(dir, sizeof(dir), "salvage"));
-	write_file(scratch(scene, sizeof(scene), "salvage/slow.pov"), slow);
-	memset(&job, 0, sizeof(job));
-	job.scene = scene;
-	job.output = scratch(out, sizeof(out), "salvage/r.exr");
-	job.width = 256;
-	job.height = 192;
-	job.region = &r;
-	job.threads = 1;
-	job.extra = aa;
-	job.nextra = 3;
-	job.salvage = 1;
+	write_file(scratch(scene, sizeof(scene), "salvage/slow.pov"), salvage_scene);
+	salvage_job(&job, scene, scratch(out, sizeof(out), "salvage/r.exr"));
 	pov_pool_opts_init(&o);
 	o.max_jobs = 1;
 	o.deadline_s = 2.0;
@@ -1793,6 +1801,74 @@ static void signal_during_pool(int sig)
 	assert_int_equal(count_procs(tag), 0);
 }
 
+/*
+ * A render with salvage stopped by SIGINT: in a child process, one job of
+ * the salvage scene; exit 42 if the pool reported POV_INTERRUPTED and the
+ * job cancelled with some of its pixels kept, not all.
+ */
+static void salvaged_child(const char *scene, const char *out)
+{
+	struct pov_job job;
+	struct pov_result res;
+	struct pov_pool_opts o;
+	char err[512];
+
+	salvage_job(&job, scene, out);
+	pov_pool_opts_init(&o);
+	o.max_jobs = 1;
+	o.grace_s = 2.0;
+	const int rc = pov_pool_run(&job, 1, &o, &res, err, sizeof(err));
+	const long all = (long)(salvage_region.x1 - salvage_region.x0 + 1) *
+			 (salvage_region.y1 - salvage_region.y0 + 1);
+	const int ok = rc == POV_INTERRUPTED && res.status == POV_CANCELLED &&
+		       res.partial_pixels >= 32 * 32 && res.partial_pixels < all &&
+		       res.partial.w == 256 && res.partial_oy == salvage_region.y0;
+	if (!ok)
+		fprintf(stderr, "child: rc %d, %s, %ld pixels kept\n", rc, res.message,
+			res.partial_pixels);
+	_exit(ok ? 42 : 1);
+}
+
+/* SIGINT 1.5 s into the render (0.6 s of POV-Ray's start, then its first
+ * blocks): the pool keeps the blocks it finished, its state file goes. */
+static void test_sigint_salvages(void **state)
+{
+	char dir[PATH_MAX], scene[PATH_MAX], out[PATH_MAX], tag[64], name[128];
+	pid_t pid;
+	int st = 0;
+
+	(void)state;
+	snprintf(tag, sizeof(tag), "povpress-salvage-%d", (int)getpid());
+	mkdir_p(scratch(dir, sizeof(dir), "salvage-int"));
+	write_file(scratch(scene, sizeof(scene), "salvage-int/slow.pov"), salvage_scene);
+	snprintf(name, sizeof(name), "salvage-int/%s.exr", tag);
+	scratch(out, sizeof(out), name);
+	fflush(NULL);
+	pid = fork();
+	assert_true(pid >= 0);
+	if (pid == 0)
+		salvaged_child(scene, out);
+	if (wait_procs(tag, 1, 10.0) != 1) {
+		kill(pid, SIGKILL);
+		waitpid(pid, &st, 0);
+		fail_msg("no povray child running");
+	}
+	pause_s(1.5);
+	kill(pid, SIGINT);
+	double t = now_s();
+	while (waitpid(pid, &st, WNOHANG) == 0 && now_s() - t < 10)
+		pause_s(0.02);
+	if (!WIFEXITED(st)) {
+		kill(pid, SIGKILL);
+		waitpid(pid, &st, 0);
+		fail_msg("the pool process did not exit after SIGINT");
+	}
+	assert_int_equal(WEXITSTATUS(st), 42);
+	assert_int_equal(count_procs(tag), 0);
+	assert_int_equal(count_entries(dir, "pov-state"), 0);
+	assert_false(exists(out));
+}
+
 static void test_sigint_stops_pool(void **state)
 {
 	(void)state;
@@ -1971,6 +2047,7 @@ int main(void)
 		cmocka_unit_test(test_pool_progress),
 		cmocka_unit_test(test_pool_finish),
 		cmocka_unit_test(test_sigint_stops_pool),
+		cmocka_unit_test(test_sigint_salvages),
 		cmocka_unit_test(test_sigterm_stops_pool),
 		cmocka_unit_test(test_sigkill_leaves_no_orphans),
 		cmocka_unit_test(test_signal_before_pool),
