@@ -258,6 +258,24 @@ static void expect_fold(const float *b, double nb, const double m[3], const doub
 	}
 }
 
+/* A whole render img merged over all of acc, antialiased (s ACC_AA, at depth
+ * and for edges) or at scale s; the pixels it folded. */
+static long merge_whole(struct image *acc, const struct image *img, int s, int depth,
+			int edges)
+{
+	char err[256];
+	long folded = -1;
+
+	if (s == ACC_AA)
+		assert_int_equal(accum_merge_aa_region(acc, img, 0, s, depth, edges, 0, 0,
+						       acc->w - 1, acc->h - 1, 1, &folded, err,
+						       sizeof(err)), 0);
+	else
+		assert_int_equal(accum_merge_region(acc, img, 0, s, 0, 0, acc->w - 1, acc->h - 1,
+						    1, &folded, err, sizeof(err)), 0);
+	return folded;
+}
+
 /*
  * accum_merge_partial: a render stopped before it ended, its pixels not
  * rendered NaN.  A pixel with a render pixel missing is left as it was,
@@ -297,13 +315,7 @@ static void test_merge_partial(void **state)
 		struct image a = acc;
 		a.px = ref;
 		memcpy(ref, acc.px, bytes);
-		if (mode)
-			assert_int_equal(accum_merge_aa_region(&a, &whole, 0, s, depth, edges, 0, 0,
-							       W - 1, H - 1, 1, &folded, err,
-							       sizeof(err)), 0);
-		else
-			assert_int_equal(accum_merge_region(&a, &whole, 0, s, 0, 0, W - 1, H - 1, 1,
-							    &folded, err, sizeof(err)), 0);
+		folded = merge_whole(&a, &whole, s, depth, edges);
 		assert_int_equal(folded, (long)npx);
 		a.px = part;
 		memcpy(part, acc.px, bytes);
@@ -325,13 +337,7 @@ static void test_merge_partial(void **state)
 		/* the whole-render merge of the same image marks the hole */
 		a.px = marked;
 		memcpy(marked, acc.px, bytes);
-		if (mode)
-			assert_int_equal(accum_merge_aa_region(&a, &cut, 0, s, depth, edges, 0, 0,
-							       W - 1, H - 1, 1, &folded, err,
-							       sizeof(err)), 0);
-		else
-			assert_int_equal(accum_merge_region(&a, &cut, 0, s, 0, 0, W - 1, H - 1, 1,
-							    &folded, err, sizeof(err)), 0);
+		merge_whole(&a, &cut, s, depth, edges);
 		assert_true(accum_has_scale(&a, hole[0], s));
 		free(ref);
 		free(part);
