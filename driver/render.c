@@ -69,7 +69,8 @@ static const char usage_options[] =
 	"  --budget SECONDS      wall-clock seconds to stop within (default: none;\n"
 	"                        region renders still running when only the time\n"
 	"                        to merge, analyse and write the final image is\n"
-	"                        left are stopped, but one about to finish is left\n"
+	"                        left are stopped, keeping the blocks they had\n"
+	"                        finished, but one about to finish is left\n"
 	"                        up to 0.3 s (7.5% of the budget) to write its\n"
 	"                        image; a base pass still running at its end is\n"
 	"                        stopped and the run fails, with no image; its\n"
@@ -168,7 +169,8 @@ static const char usage_options2[] =
 	"waits (default: povwait.so next to povpress; 0 or empty: none).\n"
 	"\n"
 	"Exit status: 0 done, 1 failure, 2 bad usage, 130 interrupted (the output then\n"
-	"holds the best image so far, or does not exist; --resume continues).\n";
+	"holds the best image so far, or does not exist; --resume continues, with the\n"
+	"blocks the interrupted pass's renders had finished).\n";
 
 static double now_s(void)
 {
