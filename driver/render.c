@@ -2167,7 +2167,12 @@ static int spread_rank(int edges, int depth)
 }
 /*
  * Below the first level a render is taken only where the pass so spends at
- * least this share of what it may.  Where it would spend less, passes follow it, and
+ * least this share of what it may, with the regions spread_mix() moved up
+ * (until 2026-12-05 07:25 UTC the whole level's: noise_generator under 6 s,
+ * +A0.1 +R3 whole at a share of 0.33 and +R4 whole just over, took scale 2
+ * in runs where +R4 did not fit, relMSE 3.0e-5 to 3.3e-5 against 1.0e-5
+ * where it did; with the mixed pass's share, 1.2e-5 in each of three runs
+ * by turns, 07:25 to 07:30 UTC).  Where it would spend less, passes follow it, and
  * scale 2's smaller step lets them spread the budget over more pixels:
  * under --budget 6 at 640x480, Debian's textures/noise_generator,
  * textures/patterns/granite, textures/finishes/var_refl and advanced/
@@ -2178,28 +2183,6 @@ static int spread_rank(int edges, int depth)
  */
 #define SPREAD_R2_SHARE 0.4
 
-/*
- * A region's margined price at +A0.03 +R4 where it moves up to it from
- * +A0.1 +R3 (spread_mix()), in place of SPREAD_MARGIN.  At +R4 a region's
- * price missed its CPU the most, both ways: each region of soft_shadows,
- * thin_geometry, Debian's granite, var_refl, noise_generator and swirlbox
- * at 640x480 with +R4 forced (`povpress render S --budget 40 --target 1e-6
- * --max-passes 1`, a scratch switch and print, 2026-12-05 05:40 UTC) took
- * 0.63 to 1.96 times its price: the samples 0.50 to 0.96 times those priced
- * (an edge pixel's four render pixels are not all subdivided), a sample
- * 0.86 to 2.18 times the cost map's mean over the region (the edges' rays
- * are dearer than the region's; var_refl's upper regions, 1.9 and 2.2).
- * At SPREAD_MARGIN soft_shadows under --budget 3 took +R4 on two of four
- * regions and lost a render at the deadline in four runs of six (relMSE
- * 1.4e-3 to 1.6e-3, against 1.2e-4 with +A0.1 +R3 whole; 04:31 to 04:48
- * UTC, one printed 48% done); at 2, by turns against the build before
- * (three runs each under 2, 3 and 6 s, the six at 640x480, 05:48 to 05:54
- * UTC, with plan_make_from()'s upgrades made once), the new build lost
- * renders at the deadline in 1 run of 54 (noise_generator under 2 s, where
- * no region can reach +R4), the old in 4, and under 6 s var_refl,
- * swirlbox and noise_generator erred 0.78, 0.88 and 0.68 times as much.
- */
-#define MIX_MARGIN_R4 2.0
 /* Region k's margined price at level l of spread_levels (NSPREAD: the
  * scale 2 it was planned as; a region of another scale as planned), price
  * as spread_am1()'s. */
@@ -2207,7 +2190,7 @@ static double level_cost(const struct plan *pl, const double *price, size_t k, i
 {
 	if (pl->regions[k].scale != 2 || l >= NSPREAD)
 		return SPREAD_MARGIN * pl->regions[k].cost;
-	return (l ? SPREAD_MARGIN : MIX_MARGIN_R4) * price[k * NSPREAD + l];
+	return SPREAD_MARGIN * price[k * NSPREAD + l];
 }
 
 /* The wall seconds pl's renders take on `slots` jobs at once, each
@@ -2248,9 +2231,24 @@ static double mix_makespan(const struct plan *pl, const double *price, int t,
  * --budget 2 at 640x480 one run in three of soft_shadows and
  * thin_geometry, two of noise_generator and every run of var_refl lost
  * renders (relMSE 1.3e-3 to 7.8e-3, against 7.6e-5 to 3.8e-4 in the
- * others' runs; 2026-12-05 03:32 to 03:41 UTC).  A region moving up to
- * the first level, +A0.03 +R4, is priced at MIX_MARGIN_R4, not
- * SPREAD_MARGIN: its price is the least sure.  Where no level
+ * others' runs; 2026-12-05 03:32 to 03:41 UTC).  Regions move up to the
+ * first level, +A0.03 +R4, too, though its price is the least sure: each
+ * region of soft_shadows, thin_geometry, Debian's granite, var_refl,
+ * noise_generator and swirlbox at 640x480 with +R4 forced (`povpress
+ * render S --budget 40 --target 1e-6 --max-passes 1`, a scratch switch and
+ * print, 2026-12-05 05:40 UTC) took 0.63 to 1.96 times its price, the
+ * samples 0.50 to 0.96 times those priced (an edge pixel's four render
+ * pixels are not all subdivided), a sample 0.86 to 2.18 times the cost
+ * map's mean over its region (the edges' rays are dearer than the region's).
+ * Before a stopped render kept its finished blocks (pass_job()'s salvage),
+ * soft_shadows under --budget 3 took +R4 on two of four regions and lost a
+ * render at the deadline in four runs of six (relMSE 1.4e-3 to 1.6e-3,
+ * against 1.2e-4 with +A0.1 +R3 whole; 04:31 to 04:48 UTC), and the move
+ * was priced at twice its price; since, at SPREAD_MARGIN, by turns against
+ * that (three runs each under 3 and 6 s, the six, 07:15 to 07:21 UTC)
+ * relMSE 0.92 times for 1.01 times the CPU, under 6 s var_refl, swirlbox and
+ * noise_generator 0.81, 0.76 and 0.71, soft_shadows under 3 s 0.90.  Where
+ * no level
  * fits (t NSPREAD), regions move up to the last level without
  * SPREAD_R2_SHARE's test: the pass then spends what it may on scale 2
  * and the moves together, not a small share of it.
@@ -2351,10 +2349,6 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 		       !fits(SPREAD_MARGIN, sums[t], worst[t], pp, left))
 			t++;
 		mix = t > 0;
-		if (t > 0 && t < NSPREAD && !(sums[t] >= SPREAD_R2_SHARE * pp->budget)) {
-			t = NSPREAD;	/* see SPREAD_R2_SHARE */
-			mix = 0;
-		}
 	}
 	/* each scale-2 region's level: t, or t - 1 where spread_mix() so
 	 * chose */
@@ -2362,6 +2356,19 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 	if (up)
 		spread_mix(pl, pp, left, r->jobs < (int)pl->nregions ? r->jobs : (int)pl->nregions,
 			   r->latency, price, sums, t, up);
+	if (r->budget > 0.0 && t > 0 && t < NSPREAD) {
+		/* the pass's price with the regions moved up, against
+		 * SPREAD_R2_SHARE */
+		double total = sums[t];
+		for (size_t k = 0; up && k < pl->nregions; k++)
+			if (up[k])
+				total += price[k * NSPREAD + t - 1] - price[k * NSPREAD + t];
+		if (!(total >= SPREAD_R2_SHARE * pp->budget)) {
+			t = NSPREAD;	/* see SPREAD_R2_SHARE */
+			free(up);
+			up = NULL;
+		}
+	}
 	size_t n = 0;
 	for (size_t k = 0; k < pl->nregions; k++) {
 		struct plan_region *g = &pl->regions[k];
