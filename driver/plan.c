@@ -596,6 +596,35 @@ static int next_upgrade(const struct plan_params *p, const struct image *acc, si
 	return 1;
 }
 
+/* The upgrades in the order a heap of each chosen pixel's next one gives
+ * them (see plan_make_from()): the heap, and the n taken from it so far. */
+struct upgrades {
+	struct upgrade *heap, *order;
+	size_t nh, n, cap;
+};
+
+/* Take the heap's next upgrade onto up->order, the pixel's one after it into
+ * the heap: 1, 0 when the heap is empty, -1 when out of memory. */
+static int order_next(const struct plan_params *p, const struct image *acc, const double *e,
+		      int smax, struct upgrades *up)
+{
+	if (!up->nh)
+		return 0;
+	if (up->n == up->cap) {
+		size_t cap = up->cap ? 2 * up->cap : up->nh;
+		struct upgrade *o = realloc(up->order, cap * sizeof(*o));
+		if (!o)
+			return -1;
+		up->order = o;
+		up->cap = cap;
+	}
+	struct upgrade u = heap_pop(up->heap, &up->nh), v;
+	up->order[up->n++] = u;
+	if (next_upgrade(p, acc, u.i, e[u.i], u.to, smax, &v))
+		heap_push(up->heap, &up->nh, v);
+	return 1;
+}
+
 /* The pixels of the plan's image (a render's frame grows with them). */
 static double plan_px(const struct plan *out)
 {
@@ -911,7 +940,7 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	double *gain = NULL;
 	struct cand *cand = NULL;
 	unsigned char *mark = NULL, *ps = NULL;
-	struct upgrade *heap = NULL, *order = NULL;
+	struct upgrades up = { 0 };
 	unsigned char *dead = NULL;
 	struct plan_params pm = *pin;
 	const struct plan_params *p = &pm;
@@ -1038,8 +1067,7 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 	 * ones, each pixel's next entering as its last is taken, so the
 	 * attempts need not each build a heap of their own.
 	 */
-	size_t nh = 0, norder = 0, cap_order = 0;
-	if (upgrading && (!(heap = malloc(taken * sizeof(*heap))) || !(dead = malloc(npx)))) {
+	if (upgrading && (!(up.heap = malloc(taken * sizeof(*up.heap))) || !(dead = malloc(npx)))) {
 		errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w, h);
 		goto out;
 	}
@@ -1047,33 +1075,22 @@ int plan_make_from(const struct image *acc, const double *e, const struct plan_p
 		struct upgrade u;
 		size_t i = cand[t].i;
 		if (next_upgrade(p, acc, i, e[i], ps[i], smax, &u))
-			heap_push(heap, &nh, u);
+			heap_push(up.heap, &up.nh, u);
 	}
 	for (int attempt = 0;; attempt++) {
 		double total = total0, spend = spend0, lambda = lambda0;
 		if (upgrading)
 			memset(dead, 0, npx);
 		for (size_t q = 0; upgrading && total > goal && spend < upto; q++) {
-			if (q == norder) {	/* the next in the heap's order */
-				if (!nh)
-					break;
-				if (norder == cap_order) {
-					size_t nc2 = cap_order ? 2 * cap_order : taken;
-					struct upgrade *o = realloc(order, nc2 * sizeof(*order));
-					if (!o) {
-						errbuf_printf(err, errlen, "out of memory planning a "
-							      "%dx%d image", w, h);
-						goto out;
-					}
-					order = o;
-					cap_order = nc2;
-				}
-				struct upgrade u = heap_pop(heap, &nh), v;
-				order[norder++] = u;
-				if (next_upgrade(p, acc, u.i, e[u.i], u.to, smax, &v))
-					heap_push(heap, &nh, v);
+			const int more = q < up.n ? 1 : order_next(p, acc, e, smax, &up);
+			if (more < 0) {
+				errbuf_printf(err, errlen, "out of memory planning a %dx%d image", w,
+					      h);
+				goto out;
 			}
-			const struct upgrade *u = &order[q];
+			if (!more)
+				break;
+			const struct upgrade *u = &up.order[q];
 			if (dead[u->i])
 				continue;
 			if (spend + u->cost > upto) {
@@ -1188,8 +1205,8 @@ out:
 	free(cand);
 	free(mark);
 	free(ps);
-	free(heap);
-	free(order);
+	free(up.heap);
+	free(up.order);
 	free(dead);
 	free(sat);
 	free(riders);

@@ -463,7 +463,7 @@ static int plan_output(const struct pov_job *job, struct cmd *c, char *err, size
 {
 	const char *base;
 	char *dir = split_path(job->output, &base);
-	char *odir = NULL, *real = NULL, *link = NULL, *name = NULL, *dot;
+	char *odir = NULL, *real = NULL, *link = NULL, *name = NULL;
 	struct stat st;
 	size_t blen = strlen(base);
 	int rc = -1;
@@ -511,10 +511,11 @@ static int plan_output(const struct pov_job *job, struct cmd *c, char *err, size
 	if (!name)
 		goto oom;
 	c->povout = xprintf("%s/%s", odir, name);
-	dot = strrchr(name, '.');
-	*dot = '\0';	/* name ends in ".exr" */
-	c->state = xprintf("%s/%s.pov-state", odir, name);
-	if (!c->povout || !c->state)
+	if (!c->povout)
+		goto oom;
+	const size_t sl = strlen(c->povout) + sizeof(".pov-state");
+	c->state = malloc(sl);
+	if (!c->state || pov_state_path(c->povout, c->state, sl))
 		goto oom;
 	rc = 0;
 	goto out;
@@ -1306,8 +1307,8 @@ struct pjob {
 	double prog_since;	/* when the last line kept was first read */
 	char carry[64];
 	size_t ncarry;
-	/* with its job's salvage: its frame and the rows it renders */
-	int salvage, frame_w, frame_h, row0, row1;
+	const struct pov_job *job;	/* the pool's job (NULL in a prelaunch
+					 * set), for its salvage */
 };
 
 /* Move fd to 3 or above (so that dup2 onto 0, 1, 2 is a real copy). */
@@ -1571,12 +1572,15 @@ static double rusage_cpu_s(const struct rusage *ru)
  * that cannot be read gives none. */
 static void salvage(const struct pjob *j, struct pov_result *res)
 {
+	const struct pov_job *job = j->job;
 	char err[256];
 
 	image_release(&res->partial);
 	res->partial_pixels = 0;
-	if (!j->salvage ||
-	    pov_state_read(j->cmd.state, j->frame_w, j->frame_h, j->row0, j->row1, &res->partial,
+	if (!job || !job->salvage ||
+	    pov_state_read(j->cmd.state, job->width, job->height,
+			   job->region ? job->region->y0 : 0,
+			   job->region ? job->region->y1 : job->height - 1, &res->partial,
 			   &res->partial_oy, &res->partial_pixels, err, sizeof(err)))
 		return;
 	if (!res->partial_pixels)
@@ -2139,9 +2143,11 @@ static void prelaunch_take(struct pool *p, struct pov_prelaunch *pre)
 			if (!prelaunch_matches(pre, k, &p->pj[i].cmd))
 				continue;
 			struct pjob *j = &p->pj[i];
+			const struct pov_job *job = j->job;	/* the same render */
 			cmd_release(&j->cmd);
 			free(j->bin);
 			*j = pre->pj[k];
+			j->job = job;
 			memset(&pre->pj[k], 0, sizeof(pre->pj[k]));
 			pre->pj[k].fd = -1;
 			pre->pj[k].gate = -1;
@@ -2202,11 +2208,7 @@ int pov_pool_run(const struct pov_job *jobs, size_t njobs, const struct pov_pool
 		p.pj[i].fd = -1;
 		p.pj[i].gate = -1;
 		p.pj[i].want_progress = jobs[i].progress;
-		p.pj[i].salvage = jobs[i].salvage;
-		p.pj[i].frame_w = jobs[i].width;
-		p.pj[i].frame_h = jobs[i].height;
-		p.pj[i].row0 = jobs[i].region ? jobs[i].region->y0 : 0;
-		p.pj[i].row1 = jobs[i].region ? jobs[i].region->y1 : jobs[i].height - 1;
+		p.pj[i].job = &jobs[i];
 	}
 	/* Everything that can be checked is checked before anything starts. */
 	for (size_t i = 0; i < njobs; i++) {

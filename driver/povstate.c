@@ -69,6 +69,24 @@ static int int_attr(const unsigned char *from, const unsigned char *end, const c
 	return 0;
 }
 
+/* Block pixels v (five floats each, from row top, columns l..r) of rows
+ * ya..yb into out (whose first row is y0); the pixels it had not had. */
+static long put_block(struct image *out, int y0, const unsigned char *v, long l, long ya,
+		      long r, long yb, long top)
+{
+	long fresh = 0;
+	for (long y = ya; y <= yb; y++)
+		for (long x = l; x <= r; x++) {
+			const unsigned char *q =
+				v + (((size_t)(y - top) * (size_t)(r - l + 1) + (size_t)(x - l)) * 5) * 4;
+			float *o = out->px + ((size_t)(y - y0) * out->w + (size_t)x) * 3;
+			fresh += isnan(o[0]) != 0;
+			for (int c = 0; c < 3; c++)
+				o[c] = befloat(q + 4 * c);
+		}
+	return fresh;
+}
+
 int pov_state_parse(const unsigned char *data, size_t len, const char *name, int w, int h,
 		    int y0, int y1, struct image *out, int *oy, long *pixels, char *err,
 		    size_t errlen)
@@ -110,25 +128,14 @@ int pov_state_parse(const unsigned char *data, size_t len, const char *name, int
 		const unsigned char *next = find8(after, end, msg_magic);
 		const unsigned char *mend = next ? next : end;
 		long l, t, r, b;
-		if (int_attr(after, mend, "Left", &l) || int_attr(after, mend, "Top ", &t) ||
-		    int_attr(after, mend, "Righ", &r) || int_attr(after, mend, "Bott", &b) ||
-		    l < 0 || t < 0 || r >= w || b >= h || l > r || t > b ||
-		    (uint64_t)nf != (uint64_t)(r - l + 1) * (uint64_t)(b - t + 1) * 5)
-			goto skip;	/* not a block's, cut short, or not of this frame */
-		for (long y = t; y <= b; y++) {
-			if (y < y0 || y > y1)
-				continue;
-			for (long x = l; x <= r; x++) {
-				const unsigned char *q = v + (((size_t)(y - t) * (size_t)(r - l + 1) +
-							       (size_t)(x - l)) * 5) * 4;
-				float *o = out->px + ((size_t)(y - y0) * w + (size_t)x) * 3;
-				int fresh = isnan(o[0]);
-				for (int c = 0; c < 3; c++)
-					o[c] = befloat(q + 4 * c);
-				*pixels += fresh;
-			}
-		}
-skip:
+		/* a whole block of this frame, its rows wanted put in (a message
+		 * not a block's, cut short or not of this frame is left out) */
+		if (!int_attr(after, mend, "Left", &l) && !int_attr(after, mend, "Top ", &t) &&
+		    !int_attr(after, mend, "Righ", &r) && !int_attr(after, mend, "Bott", &b) &&
+		    l >= 0 && t >= 0 && r < w && b < h && l <= r && t <= b &&
+		    (uint64_t)nf == (uint64_t)(r - l + 1) * (uint64_t)(b - t + 1) * 5)
+			*pixels += put_block(out, y0, v, l, t > y0 ? t : y0, r, b < y1 ? b : y1,
+					     t);
 		m = next;
 	}
 	return 0;

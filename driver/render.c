@@ -2256,7 +2256,8 @@ static double mix_makespan(const struct plan *pl, const double *price, int t,
  * 2 times apart), and the first pass took it whole or not at all: swirlbox
  * (Debian's advanced/swirlbox) at 640x480 under --budget 2 priced +A0.3
  * +R2 at 1.79 core-s where the pass may spend 2.17, and rendered its four
- * regions at scale 2.
+ * regions at scale 2.  Returns the pass's price (unmargined) with the
+ * regions moved up.
  */
 struct mix_cand {
 	size_t k;
@@ -2273,13 +2274,14 @@ static int by_score_desc(const void *a, const void *b)
 }
 #define MIX_SLACK 0.85
 #define MIX_SPARE_S 0.1
-static void spread_mix(const struct plan *pl, const struct plan_params *pp, double left,
-		       int slots, double lat, const double *price, const double sums[NSPREAD],
-		       int t, unsigned char *up)
+static double spread_mix(const struct plan *pl, const struct plan_params *pp, double left,
+			 int slots, double lat, const double *price, const double sums[NSPREAD],
+			 int t, unsigned char *up)
 {
+	double total = SPREAD_MARGIN * (t < NSPREAD ? sums[t] : pl->cost);
 	struct mix_cand *c = malloc(pl->nregions * sizeof(*c));
 	if (!c)
-		return;	/* out of memory: level t whole */
+		return total / SPREAD_MARGIN;	/* out of memory: level t whole */
 	size_t nc = 0;
 	for (size_t k = 0; k < pl->nregions; k++) {
 		const struct plan_region *g = &pl->regions[k];
@@ -2292,7 +2294,6 @@ static void spread_mix(const struct plan *pl, const struct plan_params *pp, doub
 		nc++;
 	}
 	qsort(c, nc, sizeof(*c), by_score_desc);
-	double total = SPREAD_MARGIN * (t < NSPREAD ? sums[t] : pl->cost);
 	for (size_t i = 0; i < nc; i++) {
 		if (!(total + c[i].more <= pp->budget))
 			continue;
@@ -2303,6 +2304,7 @@ static void spread_mix(const struct plan *pl, const struct plan_params *pp, doub
 			up[c[i].k] = 0;
 	}
 	free(c);
+	return total / SPREAD_MARGIN;
 }
 
 static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan_params *pp,
@@ -2353,16 +2355,13 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 	/* each scale-2 region's level: t, or t - 1 where spread_mix() so
 	 * chose */
 	unsigned char *up = mix ? calloc(pl->nregions, 1) : NULL;
+	double total = t < NSPREAD ? sums[t] : pl->cost;	/* the pass's price */
 	if (up)
-		spread_mix(pl, pp, left, r->jobs < (int)pl->nregions ? r->jobs : (int)pl->nregions,
-			   r->latency, price, sums, t, up);
+		total = spread_mix(pl, pp, left,
+				   r->jobs < (int)pl->nregions ? r->jobs : (int)pl->nregions,
+				   r->latency, price, sums, t, up);
 	if (r->budget > 0.0 && t > 0 && t < NSPREAD) {
-		/* the pass's price with the regions moved up, against
-		 * SPREAD_R2_SHARE */
-		double total = sums[t];
-		for (size_t k = 0; up && k < pl->nregions; k++)
-			if (up[k])
-				total += price[k * NSPREAD + t - 1] - price[k * NSPREAD + t];
+		/* with the regions moved up, against SPREAD_R2_SHARE */
 		if (!(total >= SPREAD_R2_SHARE * pp->budget)) {
 			t = NSPREAD;	/* see SPREAD_R2_SHARE */
 			free(up);
@@ -2884,86 +2883,73 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	if (rc < 0)
 		goto out;
 	p.pass = pass;
-	int stopped = 0;
-	long kept = 0;	/* the stopped renders' pixels folded in */
 	char how_far[128] = "";
 	size_t at_far = 0;
 	for (size_t k = 0; k < n; k++) {
 		const struct plan_region *g = &pl.regions[k];
-		int s = g->scale;
-		p.cpu_s += results[k].cpu_s;
-		p.invocations += results[k].attempts;
-		if (results[k].status != POV_OK) {
-			const struct pov_result *q = &results[k];
-			if (q->status == POV_CANCELLED && rc != POV_INTERRUPTED) {
-				stopped++;	/* the budget's deadline */
-				const double f = q->nprogress && q->progress_total > 0
-					? (double)q->progress[q->nprogress - 1].done /
-						  (double)q->progress_total : 0.0;
-				char one[16] = "not started";
-				if (q->attempts)
-					snprintf(one, sizeof(one), "%.0f%%", 100.0 * f);
-				if (at_far < sizeof(how_far))
-					at_far += (size_t)snprintf(how_far + at_far,
-								   sizeof(how_far) - at_far, "%s%s",
-								   at_far ? ", " : "", one);
-			}
-			/* stopped at the deadline or by an interruption: the
-			 * blocks it finished, folded in */
-			long folded = 0;
-			if (q->status == POV_CANCELLED && q->partial_pixels &&
-			    accum_merge_partial(&r->acc, &q->partial, q->partial_oy, s, g->depth,
-						g->edges, g->x0, g->y0, g->x1, g->y1, pass, &folded,
-						err, errlen)) {
-				fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: "
-					"the blocks it finished: %s\n", pass, g->x0, g->y0, g->x1,
-					g->y1, err);
-				folded = 0;
-			}
-			kept += folded;
-			p.pixels += folded;
-			if (folded) {
-				const int fr = g->frame > 0 ? g->frame : 1;
-				p.samples += (double)folded * (s != ACC_AA ? s * s : fr * fr);
-			}
-			if (results[k].status != POV_CANCELLED) {
-				p.failed++;
-				fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s%s%s\n",
-					pass, g->x0, g->y0, g->x1, g->y1,
-					pov_status_name(results[k].status),
-					results[k].message[0] ? ": " : "", results[k].message);
-			}
-			continue;
-		}
+		const struct pov_result *q = &results[k];
+		const int s = g->scale;
 		long folded = 0;
-		if (plan_merge_file(&r->acc, outs[k], g, pass, &folded, err, errlen)) {
-			fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n", pass,
-				g->x0, g->y0, g->x1, g->y1, err);
-			p.failed++;
-			continue;
+		p.cpu_s += q->cpu_s;
+		p.invocations += q->attempts;
+		if (q->status == POV_CANCELLED && rc != POV_INTERRUPTED) {
+			p.stopped++;	/* the budget's deadline */
+			const double f = q->nprogress && q->progress_total > 0
+				? (double)q->progress[q->nprogress - 1].done /
+					  (double)q->progress_total : 0.0;
+			char one[16] = "not started";
+			if (q->attempts)
+				snprintf(one, sizeof(one), "%.0f%%", 100.0 * f);
+			if (at_far < sizeof(how_far))
+				at_far += (size_t)snprintf(how_far + at_far, sizeof(how_far) - at_far,
+							   "%s%s", at_far ? ", " : "", one);
 		}
-		p.regions++;
+		if (q->status == POV_OK) {
+			if (plan_merge_file(&r->acc, outs[k], g, pass, &folded, err, errlen)) {
+				fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s\n",
+					pass, g->x0, g->y0, g->x1, g->y1, err);
+				p.failed++;
+				continue;
+			}
+			p.regions++;
+			if (!r->keep)
+				unlink(outs[k]);
+		} else if (q->status != POV_CANCELLED) {
+			p.failed++;
+			fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: %s%s%s\n", pass,
+				g->x0, g->y0, g->x1, g->y1, pov_status_name(q->status),
+				q->message[0] ? ": " : "", q->message);
+			continue;
+		} else if (!q->partial_pixels) {
+			continue;
+		} else if (accum_merge_partial(&r->acc, &q->partial, q->partial_oy, s, g->depth,
+					       g->edges, g->x0, g->y0, g->x1, g->y1, pass, &folded,
+					       err, errlen)) {
+			/* stopped at the deadline or by an interruption: the blocks
+			 * it finished */
+			fprintf(stderr, "povpress render: pass %d, region %d,%d-%d,%d: the blocks it "
+				"finished: %s\n", pass, g->x0, g->y0, g->x1, g->y1, err);
+			continue;
+		} else {
+			p.kept += folded;
+		}
 		p.pixels += folded;
 		/* an antialiased render's samples: one per render pixel, its
 		 * subdivisions not counted (POV-Ray's statistics come after the
 		 * image, which the pool takes without waiting for them) */
 		const int f = g->frame > 0 ? g->frame : 1;
 		p.samples += (double)folded * (s != ACC_AA ? s * s : f * f);
-		if (!r->keep)
-			unlink(outs[k]);
 	}
 	learn_costs(r, &pp, &pl, results);
-	p.stopped = stopped;
-	p.kept = kept;
-	if (rc == POV_INTERRUPTED && kept) {
+	if (rc == POV_INTERRUPTED && p.kept) {
 		progress(r, "pass %d: interrupted, %ld pixels kept from the blocks its stopped "
-			 "renders had finished", pass, kept);
+			 "renders had finished", pass, p.kept);
 		progress_end(r);
 	}
-	if (stopped) {
+	if (p.stopped) {
 		progress(r, "pass %d: %d of %zu region renders stopped at the budget's end "
-			 "(done: %s of their pixels; %ld pixels kept)", pass, stopped, n, how_far,
-			 kept);
+			 "(done: %s of their pixels; %ld pixels kept)", pass, p.stopped, n, how_far,
+			 p.kept);
 		progress_end(r);
 	}
 	/* what a region render waits on besides its CPU, for the budget's
