@@ -275,6 +275,17 @@ struct pov_progress {
 /* Free what res owns and zero it; a zeroed result is a no-op. */
 void pov_result_release(struct pov_result *res);
 
+/*
+ * What the n one-thread renders of a pool run (res, as pov_pool_run() left
+ * them) waited on besides their CPU on cores cores: the least, over those
+ * that ran once and succeeded, of their wall time less the wall time their
+ * CPU took with the cores shared.  A render's share of the cores is theirs
+ * over the renders running alongside it on average (itself included), at
+ * most 1.  lat[0] is from a fresh start, lat[1] for renders taken from
+ * prelaunched ones (from their release); INFINITY where no render counts.
+ */
+void pov_results_latency(const struct pov_result *res, size_t n, int cores, double lat[2]);
+
 struct pov_prelaunch;
 
 struct pov_pool_opts {

@@ -92,10 +92,10 @@ static const char usage_options[] =
 	"  --timeout SECONDS     per POV-Ray run; one retry after a crash or timeout\n"
 	"                        (default: 60 + 10 x the dearest region's predicted cost)\n"
 	"  --cost-job S          the planner's cost of one POV-Ray run, seconds, and\n"
-	"  --cost-sample S       of one sample (default: measured on the base pass and\n"
-	"                        rounded to powers of two; the report has them; given,\n"
-	"                        a budget's cost map starts at 1, not at the base\n"
-	"                        pass's progress)\n"
+	"  --cost-sample S       of one sample (default: measured on the base pass,\n"
+	"                        without a --budget rounded to powers of two; the\n"
+	"                        report has them; given, a budget's cost map starts\n"
+	"                        at 1, not at the base pass's progress)\n"
 	"  --radiosity-scale K   if the scene has radiosity, re-render the whole frame\n"
 	"                        at K x the size on one thread for the radiosity\n"
 	"                        solution and keep its K x K samples per pixel (1, 2, 4\n"
@@ -1695,17 +1695,24 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 	if (r->latency < 0.0)
 		r->latency = 0.0;
 	r->radiosity = (st->have & POV_HAVE_RADIOSITY) != 0;
-	/* The plan depends on these only through their sizes, and timing noise
-	 * must not change it from run to run (--jobs 1 -- +WT1 is meant to be
-	 * reproducible): the per-sample and setup costs are rounded to powers
-	 * of two. */
+	/* Without a budget the plan depends on these only through their
+	 * sizes, and timing noise must not change it from run to run (--jobs
+	 * 1 -- +WT1 is meant to be reproducible): the per-sample and setup
+	 * costs are rounded to powers of two.  Under a budget the plan spends
+	 * measured time anyway, and the rounding's step of two changed plans
+	 * on a measurement near a step's middle: Debian's var_refl at 640x480
+	 * under --budget 3 measured 1.91e-6 s a sample rounded, not 9.54e-7,
+	 * found POV-Ray's antialiasing too dear and ended at an estimated
+	 * 2.6e-3, not 9.6e-4; granite's 0.125 s an invocation, not 0.0625,
+	 * left a quarter of its frame at scale 2 (2026-12-05). */
 	r->cost_sample_measured = r->cost_sample;
-	r->cost_sample = quantise(r->cost_sample, 1.0);
+	if (r->budget <= 0.0)
+		r->cost_sample = quantise(r->cost_sample, 1.0);
 	/* a region render repeats the setup (parse, bounding, writing its
 	 * frame): that is its cost.  It also waits on POV-Ray's latency, but
 	 * asleep, and a pass whose regions all run at once (no more than
 	 * --jobs) waits on it once whatever their number. */
-	r->cost_job = setup > 0.01 ? quantise(setup, 1.0) : 0.01;
+	r->cost_job = setup <= 0.01 ? 0.01 : r->budget > 0.0 ? setup : quantise(setup, 1.0);
 	if (r->user_cost_job > 0.0)
 		r->cost_job = r->user_cost_job;
 	if (r->user_cost_sample > 0.0) {	/* the cost of a sample at every scale */
@@ -2679,6 +2686,20 @@ enum { PASS_STOP = 2 };
  */
 #define FINISH_S 0.3
 #define FINISH_SHARE 0.075
+/*
+ * The share of the cores' time up to the deadline a pass may plan for its
+ * region renders: a first pass's renders took 0.93 to 0.96 of their wall
+ * on the two cores (granite, var_refl, noise_generator, swirlbox,
+ * soft_shadows and thin_geometry at 640x480 under --budget 2 and 3,
+ * 2026-12-05), a pass of a few small renders 0.76 to 0.81.  A plan's price
+ * misses too (a region at +A0.03 +R4 took 0.63 to 1.96 times its price),
+ * and a render stopped at the deadline leaves the blocks it had not
+ * finished at their samples before: var_refl there under --budget 6
+ * planned 9.1 core-s, its renders ended 4.3 to 5.3 s after the pass
+ * began against a deadline of 5.0 (seven runs by hand).
+ */
+#define PASS_EFFICIENCY 0.9
+
 static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 {
 	double t = now_s(), c = self_cpu();
@@ -2708,11 +2729,12 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		pp.max_regions = r->jobs > 8 ? r->jobs : 8;
 		if (r->budget > 0.0) {
 			double left = r->budget - elapsed(r);
-			/* in core-seconds, keeping a share for the analysis and
-			 * the latency of the pass's last round of jobs; no pass
-			 * when the deadline would not leave one render its
-			 * latency and setup */
-			pp.budget = (left - lat - 0.2) * r->cores * 0.8;
+			/* in core-seconds, up to the renders' deadline (the
+			 * reserve kept for the merges, the analysis and the
+			 * final image) less the latency of the pass's last
+			 * round of jobs; no pass when the deadline would not
+			 * leave one render its latency and setup */
+			pp.budget = (left - lat - reserve) * r->cores * PASS_EFFICIENCY;
 			if (pp.budget <= 0.0 || left - reserve < lat + r->cost_job) {
 				r->stop = "budget spent";
 				return PASS_STOP;
@@ -2954,15 +2976,12 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	}
 	/* what a region render waits on besides its CPU, for the budget's
 	 * next passes: less than the base pass's latency, since the pool does
-	 * not wait for POV-Ray to exit (output_whole()) */
-	double lat[2] = { INFINITY, INFINITY };	/* from a fresh start; from a
-							 * gate (taken renders) */
-	for (size_t k = 0; k < n; k++) {
-		const int taken = results[k].prelaunched != 0;
-		if (results[k].status == POV_OK && (taken || results[k].attempts == 1) &&
-		    results[k].wall_s - results[k].cpu_s < lat[taken])
-			lat[taken] = results[k].wall_s - results[k].cpu_s;
-	}
+	 * not wait for POV-Ray to exit (output_whole()); its wall less its CPU
+	 * alone, over renders sharing the cores, stopped runs with a sixth to
+	 * a fifth of their budget left (a later pass priced a wait of 0.4 to
+	 * 0.8 s on every core) */
+	double lat[2];
+	pov_results_latency(results, n, r->cores, lat);
 	if (lat[0] < INFINITY)
 		r->latency = lat[0] > 0.0 ? lat[0] : 0.0;
 	if (lat[1] < INFINITY)

@@ -605,7 +605,7 @@ ere() { printf '%s' "$1" | sed 's/[]\\.+*?(){}|^$[]/\\&/g'; }
 # tried before it, HIGH, their prices taken with render.c's SPREAD_MARGIN
 # (spread_margin): a run under 30 s
 # ($T/TAG-30.exr) prints each level's price and what the pass may spend,
-# (budget - elapsed - latency - 0.2) x 0.8 core-s on one core, and the
+# (budget - elapsed - latency - reserve) x 0.9 core-s on one core, and the
 # budget is moved so that the pass may spend the geometric middle of the
 # two prices with the margin ($T/TAG.exr, its
 # log TAG.log and report TAG.json; moved again, up to three times, where
@@ -632,7 +632,7 @@ spread_level() {
 	# sanitized build's slower analysis leaves the plan less time)
 	for try in 1 2 3 4; do
 		b=$(awk -v b="$b" -v h="${phi:-1}" -v l="${plo:-1}" -v m="${may:-1}" -v x="$m" \
-			-v y="$m" 'BEGIN { printf "%.2f", b - (m - sqrt(x * l * y * h)) / 0.8 }')
+			-v y="$m" 'BEGIN { printf "%.2f", b - (m - sqrt(x * l * y * h)) / 0.9 }')
 		"${sp[@]}" -o "$T/$tag.exr" --budget "$b" --report "$T/$tag.json" -- +WT1 \
 			2>"$T/$tag.log" ||
 			{ bad "$(basename "$scene") 320x240 --budget $b: render failed"; return 1; }

@@ -1372,6 +1372,67 @@ static void put_block(struct bytes *b, int l, int t, int r, int bt, uint32_t cou
  * match its size and one outside the frame left out; a file that is not a
  * state file an error; pov_state_path() names it as POV-Ray does.
  */
+/* pov_results_latency(): a render's wall less the wall its CPU took with
+ * the cores shared among the renders running alongside it. */
+static void result_at(struct pov_result *r, double s, double e, double cpu)
+{
+	memset(r, 0, sizeof(*r));
+	r->status = POV_OK;
+	r->attempts = 1;
+	r->start_s = s;
+	r->end_s = e;
+	r->wall_s = e - s;
+	r->cpu_s = cpu;
+}
+
+static void test_results_latency(void **state)
+{
+	(void)state;
+	struct pov_result res[6];
+	double lat[2];
+
+	/* four renders at once on two cores, each half its wall on a core:
+	 * 0.1 s, where wall less CPU alone reads 1.05 */
+	for (int k = 0; k < 4; k++)
+		result_at(&res[k], 0.0, 2.0, 0.95);
+	pov_results_latency(res, 4, 2, lat);
+	assert_float_equal(lat[0], 0.1, 1e-9);
+	assert_true(isinf(lat[1]));
+	/* alone, or with no more renders than cores: wall less CPU */
+	pov_results_latency(res, 1, 2, lat);
+	assert_float_equal(lat[0], 1.05, 1e-9);
+	pov_results_latency(res, 2, 2, lat);
+	assert_float_equal(lat[0], 1.05, 1e-9);
+
+	/* partly overlapping on one core: the first shares it half its
+	 * life (1.5 renders on average: 2 - 1.5 x 1.0), the second too
+	 * (2 - 1.5 x 1.5); the least */
+	result_at(&res[0], 0.0, 2.0, 1.0);
+	result_at(&res[1], 1.0, 3.0, 1.5);
+	pov_results_latency(res, 2, 1, lat);
+	assert_float_equal(lat[0], -0.25, 1e-9);
+
+	/* failed, retried and never started renders do not count, but a
+	 * failed one still shares the cores; a taken render goes to lat[1] */
+	result_at(&res[0], 0.0, 1.0, 0.2);	/* alone: 0.8 */
+	result_at(&res[1], 0.0, 1.0, 0.1);
+	res[1].status = POV_FAILED;
+	result_at(&res[2], 0.0, 1.0, 0.05);
+	res[2].attempts = 2;
+	memset(&res[3], 0, sizeof(res[3]));
+	result_at(&res[4], 0.5, 1.0, 0.3);	/* four running: 0.5 - 0.3 x 4 */
+	res[4].prelaunched = 1;
+	pov_results_latency(res, 5, 1, lat);
+	assert_float_equal(lat[1], 0.5 - 0.3 * 4.0, 1e-9);
+	/* the first: 1 + 1 + 1 + 0.5 render-seconds over 1 s on one core */
+	assert_float_equal(lat[0], 1.0 - 0.2 * 3.5, 1e-9);
+	res[0].status = POV_TIMED_OUT;
+	res[4].prelaunched = 0;
+	res[4].attempts = 2;
+	pov_results_latency(res, 5, 1, lat);
+	assert_true(isinf(lat[0]) && isinf(lat[1]));
+}
+
 static void test_state_parse(void **state)
 {
 	struct bytes b = { 0 };
@@ -2043,6 +2104,7 @@ int main(void)
 		cmocka_unit_test(test_render_parse_error),
 		cmocka_unit_test(test_render_salvage),
 		cmocka_unit_test(test_timeout_kills),
+		cmocka_unit_test(test_results_latency),
 		cmocka_unit_test(test_pool_deadline),
 		cmocka_unit_test(test_pool_progress),
 		cmocka_unit_test(test_pool_finish),
