@@ -703,6 +703,22 @@ if ref=$(W=320 H=240 reference "$scene"); then
 	judge "$T/am1-auto.exr" "with +AM1 +A0.03 +R4"
 	check "--sampler scale: no antialiased region" \
 		test -z "$(compgen -G "$T/am1-scale.exr.work/p*-aa.exr")"
+	# a sample at 1.8 microseconds: dear for a run without a budget (its
+	# cost rounded to 2^-19, above SPREAD_SAMPLE_S), cheap under one
+	# (measured, at most SPREAD_SAMPLE_BUDGET_S)
+	for m in target budget; do
+		opt=(--target 3e-3)
+		[[ $m == budget ]] && opt=(--target 1e-6 --budget 30)
+		taskset -c 0 "$PP" render "$scene" -o "$T/am1-$m.exr" -W 320 -H 240 "${opt[@]}" \
+			--max-passes 1 --cost-sample 1.8e-6 -v --keep-workdir -- +WT1 \
+			2>"$T/am1-$m.log" || bad "thin_geometry 320x240, 1.8e-6 s a sample, $m: render failed"
+	done
+	check "thin_geometry at 1.8e-6 s a sample, without a budget: scale 2, no +AM1" \
+		test -n "$(compgen -G "$T/am1-target.exr.work/p01-*-s2.exr")" -a \
+		-z "$(compgen -G "$T/am1-target.exr.work/p01-*-aa.exr")"
+	check "... under a budget: +AM1 in scale 2's place" \
+		grep -q "error is spread and samples are cheap: .* (+AM1) in place of scale 2" \
+		"$T/am1-budget.log"
 	# under a budget that +A0.03 +R4 does not fit but the lighter +A0.1 +R3
 	# does (ACC_AA_FOR_SPREAD_R3), that one (spread_level, above)
 	if spread_level "$scene" r3 "+A0.1 +R3" "+A0.03 +R4"; then
