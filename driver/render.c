@@ -2721,7 +2721,7 @@ enum { PASS_STOP = 2 };
  * focal_blur at 160x120 under --budget 8 planned its fourth pass at 11.4
  * and 11.7 core-s for a budget of 10.0 (its renders at scale 16, each
  * frame 2560x1920), ran 0.1 to 0.2 s past the deadline, and ended at 8.15
- * and 8.21 s (two runs by hand, 2026-12-05; in the full sweep of 09:08
+ * and 8.21 s (two runs by hand, 2026-12-05; in the full sweep of 09:07
  * UTC two of three runs ended at 8.19 and 8.31 s).  Made again for half
  * the excess (the new plan splits less), three runs ended at 7.68 to
  * 7.96 s; for all of it, at 7.27 to 7.54 s with a fifth more error.
