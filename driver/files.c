@@ -57,12 +57,15 @@ int file_write_text(const char *path, const char *text, char *err, size_t errlen
 	return file_commit(f, tmp, path, err, errlen);
 }
 
-char *file_read_text(const char *path)
+void *file_read(const char *path, size_t *len)
 {
-	FILE *f = fopen(path, "r");
+	FILE *f = fopen(path, "rb");
 	if (!f)
 		return NULL;
-	size_t cap = 4096, n = 0;
+	/* a regular file's size and 2: its end is seen in one read */
+	struct stat st;
+	size_t cap = !fstat(fileno(f), &st) && st.st_size > 0 ? (size_t)st.st_size + 2 : 4096;
+	size_t n = 0;
 	char *s = malloc(cap);
 	while (s) {
 		size_t k = fread(s + n, 1, cap - n - 1, f);
@@ -77,10 +80,23 @@ char *file_read_text(const char *path)
 			s = t;
 		}
 	}
+	if (s && ferror(f)) {
+		free(s);
+		s = NULL;
+		errno = EIO;
+	}
 	fclose(f);
-	if (s)
+	if (s) {
 		s[n] = '\0';
+		if (len)
+			*len = n;
+	}
 	return s;
+}
+
+char *file_read_text(const char *path)
+{
+	return file_read(path, NULL);
 }
 
 static int make_one(const char *dir, const char *what, char *err, size_t errlen)

@@ -25,6 +25,10 @@ void file_abort(FILE *f, const char *tmp);
 /* Write text to path through file_begin() and file_commit(). */
 int file_write_text(const char *path, const char *text, char *err, size_t errlen);
 
+/* The whole of a file, its length in *len (len may be NULL) and a NUL after
+ * it (you free() it), or NULL when it cannot be read (errno says why). */
+void *file_read(const char *path, size_t *len);
+
 /* The whole of a text file, NUL-terminated (you free() it), or NULL when it
  * cannot be read. */
 char *file_read_text(const char *path);

@@ -208,6 +208,9 @@ struct plan {
 	double est_relmse;	/* estimated image relMSE before */
 	double est_after;	/* predicted image relMSE after */
 	double cost;		/* predicted cost, seconds */
+	double budget;		/* the budget the regions were fitted to: p's,
+				 * or less where the first fit's splits ran
+				 * past it (plan_make_from()); 0: none */
 };
 
 /* Short name of an outcome ("refine", "target met", ...); static. */
@@ -230,7 +233,17 @@ int plan_pixel_errors_threads(const struct image *acc, const float *press, const
 			      double *e, double *noise, double *est, int nthreads, char *err,
 			      size_t errlen);
 
-/* Plan one pass from the pixels' estimated errors e (plan_pixel_errors()). */
+/*
+ * Plan one pass from the pixels' estimated errors e (plan_pixel_errors()).
+ * The regions are fitted to p->budget, then the dearest split so that the
+ * cores finish together, each part paying its own invocation and, at the
+ * scales rendered as whole frames, its frame; where that takes the plan
+ * past the budget by more than PLAN_SPLIT_OVER times, the pass is planned
+ * again for a budget less by half the excess (out->budget), up to
+ * PLAN_SPLIT_TRIES times.
+ */
+#define PLAN_SPLIT_OVER 1.02
+#define PLAN_SPLIT_TRIES 4
 int plan_make_from(const struct image *acc, const double *e, const struct plan_params *p,
 		   struct plan *out, char *err, size_t errlen);
 

@@ -10,9 +10,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "driver/errbuf.h"
+#include "driver/files.h"
 
 static const char state_magic[] = "POV-Ray Render State File";
 static const unsigned char msg_magic[8] = { 'P', 'O', 'V', 'R', 'A', 'Y', 'M', 'S' };
@@ -146,32 +146,12 @@ int pov_state_read(const char *path, int w, int h, int y0, int y1, struct image 
 {
 	memset(out, 0, sizeof(*out));
 	*pixels = 0;
-	FILE *f = fopen(path, "rb");
-	if (!f) {
-		errbuf_printf(err, errlen, "cannot open '%s': %s", path, strerror(errno));
-		return -1;
-	}
-	struct stat st;
-	unsigned char *data = NULL;
-	size_t len = 0;
-	if (fstat(fileno(f), &st) || st.st_size < 0) {
+	size_t len;
+	unsigned char *data = file_read(path, &len);
+	if (!data) {
 		errbuf_printf(err, errlen, "cannot read '%s': %s", path, strerror(errno));
-		fclose(f);
 		return -1;
 	}
-	len = (size_t)st.st_size;
-	if (!(data = malloc(len ? len : 1))) {
-		errbuf_printf(err, errlen, "out of memory reading '%s'", path);
-		fclose(f);
-		return -1;
-	}
-	if (fread(data, 1, len, f) != len) {
-		errbuf_printf(err, errlen, "cannot read '%s'", path);
-		free(data);
-		fclose(f);
-		return -1;
-	}
-	fclose(f);
 	int rc = pov_state_parse(data, len, path, w, h, y0, y1, out, oy, pixels, err, errlen);
 	free(data);
 	return rc;

@@ -2713,20 +2713,6 @@ enum { PASS_STOP = 2 };
  * began against a deadline of 5.0 (seven runs by hand).
  */
 #define PASS_EFFICIENCY 0.9
-/*
- * A plan over its budget by more than this share is made again for that
- * much less.  The planner fits its regions to the budget, then splits the
- * dearest so that the cores finish together, each part paying its own
- * invocation and, at the scales rendered as whole frames, its frame:
- * focal_blur at 160x120 under --budget 8 planned its fourth pass at 11.4
- * and 11.7 core-s for a budget of 10.0 (its renders at scale 16, each
- * frame 2560x1920), ran 0.1 to 0.2 s past the deadline, and ended at 8.15
- * and 8.21 s (two runs by hand, 2026-12-05; in the full sweep of 09:07
- * UTC two of three runs ended at 8.19 and 8.31 s).  Made again for half
- * the excess (the new plan splits less), three runs ended at 7.68 to
- * 7.96 s; for all of it, at 7.27 to 7.54 s with a fifth more error.
- */
-#define SPLIT_OVER 1.02
 
 static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 {
@@ -2789,20 +2775,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		pp.min_pass_gain = MIN_PASS_GAIN;
 		if (plan_make_from(&r->acc, r->est, &pp, &pl, err, errlen))
 			return -1;
-		if (pl.outcome == PLAN_REFINE && pp.budget > 0.0 && pl.cost > SPLIT_OVER * pp.budget) {
-			/* its regions split for the cores past the budget: once
-			 * more, for half the excess less (SPLIT_OVER) */
-			pp.budget -= 0.5 * (pl.cost - pp.budget);
-			if (pp.fill > pp.budget)
-				pp.fill = pp.budget;
-			plan_release(&pl);
-			if (!(pp.budget > 0.0)) {
-				r->stop = "budget spent";
-				return PASS_STOP;
-			}
-			if (plan_make_from(&r->acc, r->est, &pp, &pl, err, errlen))
-				return -1;
-		}
+		pp.budget = pl.budget;	/* less where its splits ran past it */
 		if (pl.outcome != PLAN_REFINE) {
 			r->stop = plan_outcome_name(pl.outcome);
 			plan_release(&pl);
@@ -3018,10 +2991,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	}
 	/* what a region render waits on besides its CPU, for the budget's
 	 * next passes: less than the base pass's latency, since the pool does
-	 * not wait for POV-Ray to exit (output_whole()); its wall less its CPU
-	 * alone, over renders sharing the cores, stopped runs with a sixth to
-	 * a fifth of their budget left (a later pass priced a wait of 0.4 to
-	 * 0.8 s on every core) */
+	 * not wait for POV-Ray to exit (output_whole()); counted on the
+	 * renders' share of the cores (pov_results_latency()) */
 	double lat[2];
 	pov_results_latency(results, n, r->cores, lat);
 	if (lat[0] < INFINITY)

@@ -1561,6 +1561,50 @@ static struct plan_input *plan_setup(struct plan_params *p)
 	return plan_setup_with(p, block, 1, 0.25f);
 }
 
+/* plan_make_from()'s second fit: where splitting the regions for the cores
+ * takes the plan past its budget by more than PLAN_SPLIT_OVER, the pass is
+ * planned again for a budget less by half the excess. */
+static void test_plan_split_budget(void **state)
+{
+	static const int whole[1][4] = { { 0, 0, PW - 1, PH - 1 } };
+	struct plan_params p;
+	struct plan_input *in = plan_setup_with(&p, whole, 1, 0.25f);
+	struct plan pl;
+	(void)state;
+
+	p.cost_job = 1e-3;	/* a split costs 4% of the frame at scale 2 */
+	p.min_split = 1;	/* one region: its cost */
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	assert_int_equal(pl.nregions, 1);
+	assert_true(pl.budget == 0.0);
+	const double one = pl.cost;
+	plan_release(&pl);
+	p.min_split = 2;	/* split in two: a job more */
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	assert_int_equal(pl.nregions, 2);
+	const double two = pl.cost;
+	plan_release(&pl);
+	assert_true(two > PLAN_SPLIT_OVER * 1.005 * one);
+
+	/* a budget the one region fits but its halves do not: planned again
+	 * for less, until the plan is within PLAN_SPLIT_OVER of it */
+	p.budget = 1.005 * one;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	assert_true(pl.budget <= p.budget - 0.5 * (two - p.budget) + 1e-12);
+	assert_true(pl.cost <= PLAN_SPLIT_OVER * p.budget);
+	check_regions(&pl, &p);
+	plan_release(&pl);
+
+	/* a budget both fit: planned once, for it */
+	p.budget = 2.0 * two;
+	assert_int_equal(plan_of(in, &p, &pl), PLAN_REFINE);
+	assert_true(pl.budget == p.budget);
+	assert_true(pl.cost <= p.budget);
+	plan_release(&pl);
+	image_release(&in->acc);
+	free(in);
+}
+
 /* 6. plan_make: refine, target met, no budget, packing, too little gain,
  * no gain. */
 static void test_plan_make(void **state)
@@ -2822,6 +2866,7 @@ int main(void)
 		cmocka_unit_test(test_accum_read),
 		cmocka_unit_test(test_read_rows),
 		cmocka_unit_test(test_plan_make),
+		cmocka_unit_test(test_plan_split_budget),
 		cmocka_unit_test(test_plan_budget),
 		cmocka_unit_test(test_plan_pack_ahead),
 		cmocka_unit_test(test_plan_cost_map),
