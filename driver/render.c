@@ -339,6 +339,8 @@ struct run {
 	double renders_end;	/* when the last pass's renders ended (now_s()) */
 	double tail_s;		/* from then to the end of its writes: merges,
 				 * analysis, writes (0: no region pass yet) */
+	double read_s;		/* the base pass's image read and folded, wall
+				 * seconds (0: not measured, as on --resume) */
 };
 
 static void print_usage(FILE *f)
@@ -832,9 +834,10 @@ static int write_report(struct run *r, double est, char *err, size_t errlen)
 	fprintf(f, "  ],\n  \"totals\": {\"passes\": %zu, \"wall_s\": %.3f, \"cpu_s\": %.3f, "
 		"\"driver_cpu_s\": %.3f, \"all_cpu_s\": %.3f, \"invocations\": %d, "
 		"\"failed\": %d, \"pixels\": %ld, \"samples\": %.0f, "
-		"\"samples_per_pixel\": %.4g, \"est_relmse\": %.6g, \"own_cpu_s\": %.3f}\n}\n",
+		"\"samples_per_pixel\": %.4g, \"est_relmse\": %.6g, \"own_cpu_s\": %.3f, "
+		"\"elapsed_s\": %.3f}\n}\n",
 		r->npasses, tw, tc, td, tc + td, ti, tf, tp, ts, ts / ((double)r->w * r->h), est,
-		self_cpu());
+		self_cpu(), elapsed(r));
 	return file_commit(f, tmp, r->report, err, errlen);
 }
 
@@ -1651,12 +1654,14 @@ static int base_pass(struct run *r, char *err, size_t errlen)
 		goto out;
 	ret = -1;
 	struct image img = {0};
+	const double tr = now_s();
 	if (image_read_exr(out, &img, err, errlen))
 		goto out;
 	int rc = accum_from_base(&img, out, &r->acc, err, errlen);
 	image_release(&img);
 	if (rc)
 		goto out;
+	r->read_s = now_s() - tr;
 	/* the cost model */
 	const struct pov_stats *st = &res.stats;
 	double trace = (st->have & POV_HAVE_TRACE) ? st->trace.cpu_s : res.cpu_s;
@@ -2466,7 +2471,11 @@ static int one_step(const struct run *r, int *sparse)
  * What a pass keeps of the budget after its renders, wall seconds: what
  * the last region pass took from its renders' end to its image written
  * (merging the renders, the analysis, the writes; before the first, the
- * base pass's analysis and writes), then the final stage: under --final
+ * base pass's analysis and writes, and the merge of renders at twice the
+ * image's size over the frame, ACC_GRID_FRAME^2 times the base pass's image
+ * read and folded: without it the first pass's renders at 640x480 ended
+ * 0.36 to 0.46 s before the run, for a reserve of 0.38 to 0.49, and runs
+ * under 6 s ended at 5.98 to 6.04 s, 2026-12-05), then the final stage: under --final
  * auto the filter (measured at 0.3 to 0.45 of an analysis: 0.14 s against
  * 0.28 to 0.45 s at 640x480 on two cores, 2026-11-23), the image
  * compressed (the passes write it uncompressed, but for the first, timed
@@ -2482,7 +2491,8 @@ static int one_step(const struct run *r, int *sparse)
 static double final_reserve(const struct run *r)
 {
 	const double a = r->passes[r->npasses - 1].analysis_s;
-	const double tail = r->tail_s > 0.0 ? r->tail_s : a + r->write_s;
+	const double tail = r->tail_s > 0.0 ? r->tail_s
+					     : a + r->write_s + ACC_GRID_FRAME * ACC_GRID_FRAME * r->read_s;
 	return tail + (r->filter ? FILTER_SHARE * a : 0.0) + (1.0 + MAP_SHARE) * r->comp_s + 0.1;
 }
 
@@ -2828,8 +2838,9 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	char **outs = calloc(n, sizeof(char *));
 	struct pov_result *results = calloc(n, sizeof(*results));
 	const char **bextra = calloc(r->nextra + 4, sizeof(char *));
+	double *price = calloc(n, sizeof(*price));
 	int ret = -1;
-	if (!jobs || !regs || !extras || !outs || !results || !bextra) {
+	if (!jobs || !regs || !extras || !outs || !results || !bextra || !price) {
 		errbuf_printf(err, errlen, "out of memory");
 		goto out;
 	}
@@ -2852,6 +2863,21 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	/* what this pass renders, for inspection and for running elsewhere */
 	if (plan_regions_save(wpath(r, "regions.tsv"), &pl, pass, outs, err, errlen))
 		goto out;
+	/* each render's CPU by the cost model, and the pass's: +AM2 in scale
+	 * 2's place is planned as scale 2, but priced by its modelled cost (at
+	 * 640x480 Debian's advanced/bwstripe, edges everywhere, took 21 CPU s a
+	 * render planned at 0.3 s) */
+	double priced = 0.0, aa_priced = 0.0;
+	for (size_t k = 0; k < n; k++) {
+		const struct plan_region *g = &pl.regions[k];
+		const int edge = g->scale == ACC_AA && g->frame > 0 && !accum_for_spread(g->edges);
+		price[k] = edge ? edge_render_cost(&pp, g, r->acc.w,
+						   edge_pixels(&r->acc, g, ACC_AA_THRESHOLD),
+						   accum_aa_depth(g->depth))
+				: g->cost;
+		priced += price[k];
+		aa_priced += edge ? price[k] : 0.0;
+	}
 	struct pov_pool_opts po;
 	pov_pool_opts_init(&po);
 	po.max_jobs = r->jobs < (int)n ? r->jobs : (int)n;
@@ -2860,20 +2886,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		/* a minute plus ten times what the dearest region should cost:
 		 * a region at scale 16 can cost far more than the base pass */
 		double worst = 0.0;
-		for (size_t k = 0; k < n; k++) {
-			const struct plan_region *g = &pl.regions[k];
-			/* +AM2 in scale 2's place is planned as scale 2: its
-			 * modelled cost (at 640x480 Debian's advanced/bwstripe,
-			 * edges everywhere, took 21 CPU s a render planned at
-			 * 0.3 s, inside the timeout only by the image's size) */
-			const double gc =
-				g->scale == ACC_AA && g->frame > 0 && !accum_for_spread(g->edges)
-					? edge_render_cost(&pp, g, r->acc.w,
-							   edge_pixels(&r->acc, g, ACC_AA_THRESHOLD),
-							   accum_aa_depth(g->depth))
-					: g->cost;
-			worst = gc > worst ? gc : worst;
-		}
+		for (size_t k = 0; k < n; k++)
+			worst = price[k] > worst ? price[k] : worst;
 		po.timeout_s = 60.0 + 10.0 * worst;
 	}
 	po.on_done = on_done;
@@ -2903,8 +2917,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	/* the pass should take its CPU over the cores, or the latency of its
 	 * rounds of jobs, whichever is longer */
 	double rounds = ceil((double)n / po.max_jobs);
-	double cpu_wall = (pl.cost - (double)n * r->cost_job) / (n < (size_t)r->cores ? (double)n :
-								    r->cores);
+	double cpu_wall = (priced - (double)n * r->cost_job) / (n < (size_t)r->cores ? (double)n :
+								   r->cores);
 	double guess = rounds * r->latency > cpu_wall ? rounds * r->latency : cpu_wall;
 	if (naa)
 		aa_progress(r, pass, &pl, naa);
@@ -2978,6 +2992,18 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 		p.samples += (double)folded * (s != ACC_AA ? s * s : f * f);
 	}
 	learn_costs(r, &pp, &pl, results);
+	if (r->verbose && aa_priced > 0.0) {
+		/* POV-Ray's subdivisions are priced by edge_render_cost(), a
+		 * model that missed by 0.64 to 6.2 times over seven scenes */
+		double used = 0.0;
+		for (size_t k = 0; k < n; k++) {
+			const struct plan_region *g = &pl.regions[k];
+			if (g->scale == ACC_AA && g->frame > 0 && !accum_for_spread(g->edges))
+				used += results[k].cpu_s;
+		}
+		progress(r, "pass %d: its antialiased renders took %.2f CPU s, priced at %.2f",
+			 pass, used, aa_priced);
+	}
 	if (rc == POV_INTERRUPTED && p.kept) {
 		progress(r, "pass %d: interrupted, %ld pixels kept from the blocks its stopped "
 			 "renders had finished", pass, p.kept);
@@ -3025,6 +3051,7 @@ out:
 	free(extras);
 	free(outs);
 	free(results);
+	free(price);
 	free(bextra);
 	free(pre_idx);
 	pov_prelaunch_end(pre);

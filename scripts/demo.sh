@@ -64,7 +64,7 @@ pov_cpu=$(jget "$OUT/render.json" cpu_s)
 own_cpu=$(jget "$OUT/render.json" own_cpu_s)
 printf '  cost: %s CPU s (POV-Ray %s, povpress %s), %s s wall, %s samples per pixel\n' \
 	"$(awk -v a="$pov_cpu" -v b="$own_cpu" 'BEGIN { printf "%.3f", a + b }')" \
-	"$pov_cpu" "$own_cpu" "$(jget "$OUT/render.json" wall_s)" \
+	"$pov_cpu" "$own_cpu" "$(jget "$OUT/render.json" elapsed_s)" \
 	"$(jget "$OUT/render.json" samples_per_pixel)"
 
 oiiotool "$OUT/render.exr" --colorconvert linear sRGB -o "$OUT/render.png"
