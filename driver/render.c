@@ -1932,6 +1932,13 @@ static double aa_render_cost(const struct plan_params *pp, const struct plan_reg
 	return pp->cost_job + cost_sample * m * (f2 * (double)plan_region_area(g) + more * (double)e);
 }
 
+/* Whether region g is an antialiased render in scale 2's place taken for
+ * edges or a few pixels: priced by edge_render_cost(), not as planned. */
+static int priced_as_edges(const struct plan_region *g)
+{
+	return g->scale == ACC_AA && g->frame > 0 && !accum_for_spread(g->edges);
+}
+
 /* The cost above of region g, of an image w pixels wide, with e edge
  * pixels (edge_pixels()), at depth d. */
 static double edge_render_cost(const struct plan_params *pp, const struct plan_region *g, int w,
@@ -2475,8 +2482,8 @@ static int one_step(const struct run *r, int *sparse)
  * image's size over the frame, ACC_GRID_FRAME^2 times the base pass's image
  * read and folded: without it the first pass's renders at 640x480 ended
  * 0.36 to 0.46 s before the run, for a reserve of 0.38 to 0.49, and runs
- * under 6 s ended at 5.98 to 6.04 s, 2026-12-05), then the final stage: under --final
- * auto the filter (measured at 0.3 to 0.45 of an analysis: 0.14 s against
+ * under 6 s ended at 5.98 to 6.04 s, 2026-12-05), then the final stage:
+ * under --final auto the filter (measured at 0.3 to 0.45 of an analysis: 0.14 s against
  * 0.28 to 0.45 s at 640x480 on two cores, 2026-11-23), the image
  * compressed (the passes write it uncompressed, but for the first, timed
  * for this) and the error map beside it (MAP_SHARE as long: its 8
@@ -2870,7 +2877,7 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	double priced = 0.0, aa_priced = 0.0;
 	for (size_t k = 0; k < n; k++) {
 		const struct plan_region *g = &pl.regions[k];
-		const int edge = g->scale == ACC_AA && g->frame > 0 && !accum_for_spread(g->edges);
+		const int edge = priced_as_edges(g);
 		price[k] = edge ? edge_render_cost(&pp, g, r->acc.w,
 						   edge_pixels(&r->acc, g, ACC_AA_THRESHOLD),
 						   accum_aa_depth(g->depth))
@@ -2994,13 +3001,12 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	learn_costs(r, &pp, &pl, results);
 	if (r->verbose && aa_priced > 0.0) {
 		/* POV-Ray's subdivisions are priced by edge_render_cost(), a
-		 * model that missed by 0.64 to 6.2 times over seven scenes */
+		 * model that took 0.64 to 6.2 times its price over seven scenes
+		 * (README, On scenes it was not tuned for) */
 		double used = 0.0;
-		for (size_t k = 0; k < n; k++) {
-			const struct plan_region *g = &pl.regions[k];
-			if (g->scale == ACC_AA && g->frame > 0 && !accum_for_spread(g->edges))
+		for (size_t k = 0; k < n; k++)
+			if (priced_as_edges(&pl.regions[k]))
 				used += results[k].cpu_s;
-		}
 		progress(r, "pass %d: its antialiased renders took %.2f CPU s, priced at %.2f",
 			 pass, used, aa_priced);
 	}
