@@ -28,7 +28,9 @@
 # total_cpu_s.  cpu_s is the report's all_cpu_s (the POV-Ray children and
 # povpress while they ran and merged, not its analyses); total_cpu_s adds
 # all of povpress's own CPU (cpu_s + own_cpu_s of the report's totals), as
-# make sweep counts a run, for ratios to POV-Ray's envelope.
+# make sweep counts a run, for ratios to POV-Ray's envelope.  wall_s is the
+# report's elapsed_s, the run's whole wall time (a build older than it: its
+# passes' wall_s, which leave out the final image and error map).
 set -euo pipefail
 
 usage() {
