@@ -915,10 +915,22 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
 	if (rc)
 		return -1;
 	if (res->status == POV_CANCELLED && deadline > 0.0) {
+		/* how far it got, by its progress lines: the time the whole
+		 * frame would take at its rate so far, for the user's next
+		 * budget (none while POV-Ray still parsed or set up) */
+		char far[160] = "";
+		const struct pov_progress *last =
+			res->nprogress ? &res->progress[res->nprogress - 1] : NULL;
+		if (last && res->progress_total > 0 && last->done > 0 && last->t > 0.0) {
+			const double f = (double)last->done / (double)res->progress_total;
+			snprintf(far, sizeof far, " (it rendered %.0f%% of its pixels in %.1f s; "
+				 "at that rate the frame alone takes about %.0f s)", 100.0 * f,
+				 last->t, ceil(last->t / f));
+		}
 		errbuf_printf(err, errlen, "the %s of '%s' (%dx%d) did not finish within the "
-			      "budget of %g s: there is no image to refine; give a larger "
+			      "budget of %g s%s: there is no image to refine; give a larger "
 			      "--budget or a smaller -W/-H", what, r->scene, r->w * k, r->h * k,
-			      r->budget);
+			      r->budget, far);
 		return -1;
 	}
 	if (res->status != POV_OK) {

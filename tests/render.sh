@@ -1085,6 +1085,12 @@ dt=$(awk -v a="$t0" -v b="$EPOCHREALTIME" 'BEGIN { printf "%.2f", b - a }')
 check "base pass past the budget: the run fails" test $rc -ne 0
 check "... saying so: $(head -c 150 "$T/bb.err")" \
 	grep -q "base pass .* did not finish within the budget of 1 s" "$T/bb.err"
+# how far it got, from POV-Ray's progress lines, and what the frame would
+# take at that rate: more than the budget
+need=$(sed -n 's/.*of its pixels in [0-9.]* s; at that rate the frame alone takes about \([0-9]*\) s).*/\1/p' \
+	"$T/bb.err")
+check "... saying how far it got and what the frame would take (about ${need:-?} s)" \
+	num 'a > 1' "${need:-0}"
 check "... stopped at the budget's end, not the pass's ($dt s)" num 'a <= 2.5' "$dt"
 check "... no output file" test ! -e "$T/bb.exr"
 check "... no POV-Ray child left" no_povray_left "$T/bb work"
