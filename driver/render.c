@@ -917,7 +917,8 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
 	if (res->status == POV_CANCELLED && deadline > 0.0) {
 		/* how far it got, by its progress lines: the time the whole
 		 * frame would take at its rate so far, for the user's next
-		 * budget (none while POV-Ray still parsed or set up) */
+		 * budget; none while POV-Ray still parsed or set up (Debian's
+		 * camera/mesh_camera/meshcam_ortho_demo.pov under 8 s) */
 		char far[160] = "";
 		const struct pov_progress *last =
 			res->nprogress ? &res->progress[res->nprogress - 1] : NULL;
@@ -926,6 +927,9 @@ static int whole_frame(struct run *r, int k, int threads, const char *out,
 			snprintf(far, sizeof far, " (it rendered %.0f%% of its pixels in %.1f s; "
 				 "at that rate the frame alone takes about %.0f s)", 100.0 * f,
 				 last->t, ceil(last->t / f));
+		} else {
+			snprintf(far, sizeof far, " (it rendered no pixel: POV-Ray was still "
+				 "parsing or preparing the scene)");
 		}
 		errbuf_printf(err, errlen, "the %s of '%s' (%dx%d) did not finish within the "
 			      "budget of %g s%s: there is no image to refine; give a larger "
