@@ -933,7 +933,7 @@ static double *map_table(const float *map, int w, int h)
 }
 
 static int make_once(const struct image *acc, const double *e, const struct plan_params *pin,
-		   struct plan *out, char *err, size_t errlen)
+		     struct plan *out, char *err, size_t errlen)
 {
 	const int w = acc->w, h = acc->h;
 	const size_t npx = (size_t)w * h;

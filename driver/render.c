@@ -2499,15 +2499,14 @@ static int one_step(const struct run *r, int *sparse)
  * read and folded: without it the first pass's renders at 640x480 ended
  * 0.36 to 0.46 s before the run, for a reserve of 0.38 to 0.49, and runs
  * under 6 s ended at 5.98 to 6.04 s, 2026-12-05), then the final stage:
- * under --final auto the filter (measured at 0.3 to 0.45 of an analysis: 0.14 s against
- * 0.28 to 0.45 s at 640x480 on two cores, 2026-11-23), the image
- * compressed (the passes write it uncompressed, but for the first, timed
- * for this) and the error map beside it (MAP_SHARE as long: its 8
+ * under --final auto the filter (measured at 0.3 to 0.45 of an analysis:
+ * 0.14 s against 0.28 to 0.45 s at 640x480 on two cores, 2026-11-23), the
+ * image compressed (the passes write it uncompressed, but for the first,
+ * timed for this) and the error map beside it (MAP_SHARE as long: its 8
  * channels took 1.18 to 1.19 times the image's time to write at 160x120
- * and 640x480), and 0.1 s.  With
- * the analysis and 0.1 s alone, soft_shadows at 640x480 under --budget 4
- * ended at 4.2 s without the filter, 4.4 to 4.6 s with it (the final
- * stage 0.4 s, the merges 0.13 s).
+ * and 640x480), and 0.1 s.  With the analysis and 0.1 s alone,
+ * soft_shadows at 640x480 under --budget 4 ended at 4.2 s without the
+ * filter, 4.4 to 4.6 s with it (the final stage 0.4 s, the merges 0.13 s).
  */
 #define FILTER_SHARE 0.5
 #define MAP_SHARE 1.2
@@ -2861,9 +2860,8 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	char **outs = calloc(n, sizeof(char *));
 	struct pov_result *results = calloc(n, sizeof(*results));
 	const char **bextra = calloc(r->nextra + 4, sizeof(char *));
-	double *price = calloc(n, sizeof(*price));
 	int ret = -1;
-	if (!jobs || !regs || !extras || !outs || !results || !bextra || !price) {
+	if (!jobs || !regs || !extras || !outs || !results || !bextra) {
 		errbuf_printf(err, errlen, "out of memory");
 		goto out;
 	}
@@ -2886,20 +2884,21 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	/* what this pass renders, for inspection and for running elsewhere */
 	if (plan_regions_save(wpath(r, "regions.tsv"), &pl, pass, outs, err, errlen))
 		goto out;
-	/* each render's CPU by the cost model, and the pass's: +AM2 in scale
-	 * 2's place is planned as scale 2, but priced by its modelled cost (at
-	 * 640x480 Debian's advanced/bwstripe, edges everywhere, took 21 CPU s a
-	 * render planned at 0.3 s) */
-	double priced = 0.0, aa_priced = 0.0;
+	/* the pass's CPU by the cost model, its edge renders' and its dearest
+	 * render's: +AM2 in scale 2's place is planned as scale 2, but priced
+	 * by its modelled cost (at 640x480 Debian's advanced/bwstripe, edges
+	 * everywhere, took 21 CPU s a render planned at 0.3 s) */
+	double priced = 0.0, aa_priced = 0.0, worst = 0.0;
 	for (size_t k = 0; k < n; k++) {
 		const struct plan_region *g = &pl.regions[k];
 		const int edge = priced_as_edges(g);
-		price[k] = edge ? edge_render_cost(&pp, g, r->acc.w,
-						   edge_pixels(&r->acc, g, ACC_AA_THRESHOLD),
-						   accum_aa_depth(g->depth))
-				: g->cost;
-		priced += price[k];
-		aa_priced += edge ? price[k] : 0.0;
+		const double gc = edge ? edge_render_cost(&pp, g, r->acc.w,
+							  edge_pixels(&r->acc, g, ACC_AA_THRESHOLD),
+							  accum_aa_depth(g->depth))
+				       : g->cost;
+		priced += gc;
+		aa_priced += edge ? gc : 0.0;
+		worst = gc > worst ? gc : worst;
 	}
 	struct pov_pool_opts po;
 	pov_pool_opts_init(&po);
@@ -2908,9 +2907,6 @@ static int refine_pass(struct run *r, int pass, char *err, size_t errlen)
 	if (po.timeout_s <= 0.0) {
 		/* a minute plus ten times what the dearest region should cost:
 		 * a region at scale 16 can cost far more than the base pass */
-		double worst = 0.0;
-		for (size_t k = 0; k < n; k++)
-			worst = price[k] > worst ? price[k] : worst;
 		po.timeout_s = 60.0 + 10.0 * worst;
 	}
 	po.on_done = on_done;
@@ -3073,7 +3069,6 @@ out:
 	free(extras);
 	free(outs);
 	free(results);
-	free(price);
 	free(bextra);
 	free(pre_idx);
 	pov_prelaunch_end(pre);

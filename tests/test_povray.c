@@ -1366,12 +1366,6 @@ static void put_block(struct bytes *b, int l, int t, int r, int bt, uint32_t cou
 	}
 }
 
-/*
- * pov_state_parse: the blocks of a render state file, each pixel once, in
- * the rows asked for; a block cut short at the end, one whose count does not
- * match its size and one outside the frame left out; a file that is not a
- * state file an error; pov_state_path() names it as POV-Ray does.
- */
 /* pov_results_latency(): a render's wall less the wall its CPU took with
  * the cores shared among the renders running alongside it. */
 static void result_at(struct pov_result *r, double s, double e, double cpu)
@@ -1433,6 +1427,12 @@ static void test_results_latency(void **state)
 	assert_true(isinf(lat[0]) && isinf(lat[1]));
 }
 
+/*
+ * pov_state_parse: the blocks of a render state file, each pixel once, in
+ * the rows asked for; a block cut short at the end, one whose count does not
+ * match its size and one outside the frame left out; a file that is not a
+ * state file an error; pov_state_path() names it as POV-Ray does.
+ */
 static void test_state_parse(void **state)
 {
 	struct bytes b = { 0 };
