@@ -264,6 +264,12 @@ struct accum_spread accum_spread_render(int edges, int depth)
 	if (edges == ACC_AA_FOR_SPREAD_FLOOR)
 		return (struct accum_spread){ "+A0.3", "+R2", ACC_AA_SPREAD_FLOOR_THRESHOLD,
 					      ACC_AA_SPREAD_FLOOR_CELLS, 1 };
+	if (edges == ACC_AA_FOR_SPREAD_R5 || edges == ACC_AA_FOR_SPREAD_R6) {
+		const int r6 = edges == ACC_AA_FOR_SPREAD_R6,
+			  n = r6 ? ACC_AA_SPREAD_R6_SIDE : ACC_AA_SPREAD_R5_SIDE;
+		return (struct accum_spread){ "+A0.03", r6 ? "+R6" : "+R5", ACC_AA_SPREAD_THRESHOLD,
+					      4 * n * n, 0 };
+	}
 	const int d = accum_aa_depth(depth), dd = d >= 1 && d <= ACC_AA_DEPTH ? d : ACC_AA_DEPTH_V1;
 	return (struct accum_spread){ "+A0.03", side[dd - 1], ACC_AA_SPREAD_THRESHOLD,
 				      accum_edge_cells(dd), 0 };

@@ -211,7 +211,7 @@ _Static_assert(ACC_AA_FEW == 1 << (2 * 4), "ACC_AA_FEW is the cells at +R4");
  */
 enum {
 	ACC_AA_FOR_FEW = 0, ACC_AA_FOR_EDGES = 1, ACC_AA_FOR_SPREAD = 2, ACC_AA_FOR_SPREAD_R3 = 3,
-	ACC_AA_FOR_SPREAD_FLOOR = 4
+	ACC_AA_FOR_SPREAD_FLOOR = 4, ACC_AA_FOR_SPREAD_R5 = 5, ACC_AA_FOR_SPREAD_R6 = 6
 };
 #define ACC_AA_SPREAD_DEPTH 3
 #define ACC_AA_SPREAD_THRESHOLD 0.03
@@ -248,13 +248,29 @@ enum {
  * may leave a step of up to 0.3 between two of its pixels charged as 0.1.
  */
 #define ACC_AA_SPREAD_FLOOR_THRESHOLD 0.3
+/*
+ * The deeper renders for spread error (ACC_AA_FOR_SPREAD_R5 and _R6), for
+ * a budget that fits more than +A0.03 +R4: +AM1 +A0.03 +R5 or +R6 +J at
+ * twice the size (their depth column is ignored), a subdivided pixel 2 x 2
+ * render pixels of 5 x 5 or 6 x 6 samples.  POV-Ray alone at 1280x960,
+ * box-averaged to 640x480 against the sweep's references at scale 9 (one
+ * run each, CPU s and relMSE, 2026-12-05 12:55 UTC): Debian's
+ * noise_generator at +R3 to +R6 2.1e-5 in 4.0 s, 8.8e-6 in 6.3, 4.8e-6 in
+ * 9.2, 2.9e-6 in 13.1 (relMSE times CPU falling 8.2e-5, 5.5e-5, 4.3e-5,
+ * 3.8e-5), granite at +R4 and +R5 4.2e-5 in 13.5 and 2.5e-5 in 20.0;
+ * soft_shadows and thin_geometry alike at every depth (relMSE times CPU
+ * 2.1e-4 to 2.4e-4 and 5.2e-4 to 5.9e-4).  POV-Ray's sweep goes no deeper
+ * than +R4, where later passes on textures bought little.
+ */
+#define ACC_AA_SPREAD_R5_SIDE 5
+#define ACC_AA_SPREAD_R6_SIDE 6
 #define ACC_AA_SPREAD_FLOOR_SIDE 2
 #define ACC_AA_SPREAD_FLOOR_CELLS (4 * ACC_AA_SPREAD_FLOOR_SIDE * ACC_AA_SPREAD_FLOOR_SIDE)
 
 /* Whether a render in scale 2's place was taken for spread error (+AM1). */
 static inline int accum_for_spread(int edges)
 {
-	return edges >= ACC_AA_FOR_SPREAD && edges <= ACC_AA_FOR_SPREAD_FLOOR;
+	return edges >= ACC_AA_FOR_SPREAD && edges <= ACC_AA_FOR_SPREAD_R6;
 }
 
 /*

@@ -1385,7 +1385,7 @@ static int regions_tail(char *s, struct plan_region *r)
 	if (*end || errno || d > ACC_AA_DEPTH)
 		return -1;
 	long e = strtol(t2 + 1, &end, 10);
-	if (*end || errno || e < ACC_AA_FOR_FEW || e > ACC_AA_FOR_SPREAD_FLOOR)
+	if (*end || errno || e < ACC_AA_FOR_FEW || e > ACC_AA_FOR_SPREAD_R6)
 		return -1;
 	if ((d || e) && (r->scale != ACC_AA || !d))
 		return -1;	/* only an antialiased render has them */

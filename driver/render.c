@@ -134,8 +134,9 @@ static const char usage_options2[] =
 	"                        a sample costs at most 1.5 microseconds (2 under\n"
 	"                        a budget, measured, not rounded), scale 2\n"
 	"                        as one render at twice the size with POV-Ray's\n"
-	"                        +AM1 +A0.03 +R4 +J (under a budget only where it\n"
-	"                        fits); scale throughout where the\n"
+	"                        +AM1 +A0.03 +R4 +J (under a budget +R6 or +R5\n"
+	"                        where those fit, lighter ones where +R4 does\n"
+	"                        not); scale throughout where the\n"
 	"                        file sets assumed_gamma other than 1, in whose\n"
 	"                        encoding POV-Ray's antialiasing averages), grid\n"
 	"                        (scales 4, 8 and 16 as renders at twice the size with\n"
@@ -2189,20 +2190,40 @@ static size_t aa_depth(const struct run *r, struct plan *pl, const struct plan_p
 #define SPREAD_MARGIN 1.25
 /*
  * The renders a pass's scale-2 regions may become, in the order tried:
- * +A0.03 +R4 (ACC_AA_SPREAD_DEPTH), then under a budget that it does not
- * fit the lighter +A0.1 +R3 (ACC_AA_FOR_SPREAD_R3, accum.h), +A0.03 +R2
- * and +A0.3 +R2 (ACC_AA_FOR_SPREAD_FLOOR), each as its edges and depth
+ * under a budget first the deeper +A0.03 +R6 and +R5 (ACC_AA_FOR_SPREAD_R6
+ * and _R5, accum.h), then (without a budget, first) +A0.03 +R4
+ * (ACC_AA_SPREAD_DEPTH, at SPREAD_R4), then under a budget that it does
+ * not fit the lighter +A0.1 +R3 (ACC_AA_FOR_SPREAD_R3), +A0.03 +R2 and
+ * +A0.3 +R2 (ACC_AA_FOR_SPREAD_FLOOR), each as its edges and depth
  * (accum_spread_render() has its threshold and cells).
  */
 static const struct spread_level {
 	int edges, depth;
 } spread_levels[] = {
+	{ ACC_AA_FOR_SPREAD_R6, ACC_AA_SPREAD_DEPTH },
+	{ ACC_AA_FOR_SPREAD_R5, ACC_AA_SPREAD_DEPTH },
 	{ ACC_AA_FOR_SPREAD, ACC_AA_SPREAD_DEPTH },
 	{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_DEPTH },
 	{ ACC_AA_FOR_SPREAD, 2 },
 	{ ACC_AA_FOR_SPREAD_FLOOR, 2 },
 };
-enum { NSPREAD = sizeof spread_levels / sizeof spread_levels[0] };
+enum { NSPREAD = sizeof spread_levels / sizeof spread_levels[0], SPREAD_R4 = 2 };
+/*
+ * The margin of the deeper levels, +R6 and +R5, which are taken whole or
+ * not at all (no region of a pass moves up to them: spread_mix() mixes
+ * only the levels below +R4 with the one above).  A deeper pass takes
+ * most of the budget, and a render of it stopped at the deadline keeps
+ * only its finished blocks: with SPREAD_MARGIN and the moves, Debian's
+ * var_refl at 640x480 under --budget 12 took +R5 on two regions and +R6
+ * on three, and one run in four ended at relMSE 4.3e-4 against 3.7e-5
+ * (the pass's POV-Ray CPU over its price at +R6 whole, --budget 40
+ * --max-passes 1: var_refl 1.26, thin_geometry 1.25, soft_shadows 1.10,
+ * granite 1.05, noise_generator 0.86, swirlbox 0.69; 2026-12-05 12:30
+ * UTC); with this margin and the moves, under --budget 6 soft_shadows and
+ * swirlbox moved regions to +R5 where later passes had done better (1.21
+ * and 1.17 times the relMSE) and var_refl lost a render in one run of two.
+ */
+#define SPREAD_DEEP_MARGIN 1.4
 /* The place in spread_levels of the render of edges and depth (NSPREAD
  * where none). */
 static int spread_rank(int edges, int depth)
@@ -2230,6 +2251,12 @@ static int spread_rank(int edges, int depth)
  */
 #define SPREAD_R2_SHARE 0.4
 
+/* The margin of level l of spread_levels (NSPREAD: scale 2). */
+static double level_margin(int l)
+{
+	return l < SPREAD_R4 ? SPREAD_DEEP_MARGIN : SPREAD_MARGIN;
+}
+
 /* Region k's margined price at level l of spread_levels (NSPREAD: the
  * scale 2 it was planned as; a region of another scale as planned), price
  * as spread_am1()'s. */
@@ -2237,7 +2264,7 @@ static double level_cost(const struct plan *pl, const double *price, size_t k, i
 {
 	if (pl->regions[k].scale != 2 || l >= NSPREAD)
 		return SPREAD_MARGIN * pl->regions[k].cost;
-	return SPREAD_MARGIN * price[k * NSPREAD + l];
+	return level_margin(l) * price[k * NSPREAD + l];
 }
 
 /* The wall seconds pl's renders take on `slots` jobs at once, each
@@ -2325,10 +2352,11 @@ static double spread_mix(const struct plan *pl, const struct plan_params *pp, do
 			 int slots, double lat, const double *price, const double sums[NSPREAD],
 			 int t, unsigned char *up)
 {
-	double total = SPREAD_MARGIN * (t < NSPREAD ? sums[t] : pl->cost);
+	const double m = t < NSPREAD ? level_margin(t) : SPREAD_MARGIN;
+	double total = m * (t < NSPREAD ? sums[t] : pl->cost);
 	struct mix_cand *c = malloc(pl->nregions * sizeof(*c));
 	if (!c)
-		return total / SPREAD_MARGIN;	/* out of memory: level t whole */
+		return total / m;	/* out of memory: level t whole */
 	size_t nc = 0;
 	for (size_t k = 0; k < pl->nregions; k++) {
 		const struct plan_region *g = &pl->regions[k];
@@ -2351,7 +2379,7 @@ static double spread_mix(const struct plan *pl, const struct plan_params *pp, do
 			up[c[i].k] = 0;
 	}
 	free(c);
-	return total / SPREAD_MARGIN;
+	return total / m;
 }
 
 static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan_params *pp,
@@ -2394,12 +2422,12 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 			worst[t] = c > worst[t] ? c : worst[t];
 		}
 	}
-	int t = 0, mix = 0;
+	int t = r->budget > 0.0 ? 0 : SPREAD_R4, mix = 0;
 	if (r->budget > 0.0) {
 		while (t < NSPREAD &&
-		       !fits(SPREAD_MARGIN, sums[t], worst[t], pp, left))
+		       !fits(level_margin(t), sums[t], worst[t], pp, left))
 			t++;
-		mix = t > 0;
+		mix = t > SPREAD_R4;
 	}
 	/* each scale-2 region's level: t, or t - 1 where spread_mix() so
 	 * chose */
@@ -2409,7 +2437,7 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 		total = spread_mix(pl, pp, left,
 				   r->jobs < (int)pl->nregions ? r->jobs : (int)pl->nregions,
 				   r->latency, price, sums, t, up);
-	if (r->budget > 0.0 && t > 0 && t < NSPREAD) {
+	if (r->budget > 0.0 && t > SPREAD_R4 && t < NSPREAD) {
 		/* with the regions moved up, against SPREAD_R2_SHARE */
 		if (!(total >= SPREAD_R2_SHARE * pp->budget)) {
 			t = NSPREAD;	/* see SPREAD_R2_SHARE */
@@ -2678,7 +2706,8 @@ static void aa_progress(struct run *r, int pass, const struct plan *pl, size_t n
 	char how[2][32], all[96];
 	for (int l = 0; l < nl; l++) {
 		const struct accum_spread sp = accum_spread_render(lv[l].edges, lv[l].depth);
-		if (accum_for_spread(lv[l].edges) && (sp.light || nl > 1))
+		if (accum_for_spread(lv[l].edges) &&
+		    (sp.light || nl > 1 || lv[l].edges != ACC_AA_FOR_SPREAD))
 			snprintf(how[l], sizeof(how[l]), "%s %s", sp.a, sp.r);
 		else
 			snprintf(how[l], sizeof(how[l]), "depth %d", lv[l].depth);

@@ -618,7 +618,8 @@ ere() { printf '%s' "$1" | sed 's/[]\\.+*?(){}|^$[]/\\&/g'; }
 # its scale-2 regions rendered by POV-Ray's +AM1 at twice the size), under
 # a budget that fits the render level LOW (as -v names it) but not the one
 # tried before it, HIGH, their prices taken with render.c's SPREAD_MARGIN
-# (spread_margin): a run under 30 s
+# (spread_margin; MARGIN, a fifth argument, for levels of another): a run
+# under 30 s
 # ($T/TAG-30.exr) prints each level's price and what the pass may spend,
 # (budget - elapsed - latency - reserve) x 0.9 core-s on one core, and the
 # budget is moved so that the pass may spend the geometric middle of the
@@ -630,7 +631,7 @@ ere() { printf '%s' "$1" | sed 's/[]\\.+*?(){}|^$[]/\\&/g'; }
 # budget; fails when a run fails.
 spread_margin=1.25
 spread_level() {
-	local scene=$1 tag=$2 lo=$3 hi=$4 m=$spread_margin b plo phi may m2 a1 try
+	local scene=$1 tag=$2 lo=$3 hi=$4 m=${5:-$spread_margin} b plo phi may m2 a1 try
 	local sp=(taskset -c 0 "$PP" render "$scene" -W 320 -H 240 --target 1e-6 --max-passes 1
 		--cost-sample 1e-6 --cost-job 0.05 -v --keep-workdir)
 	"${sp[@]}" -o "$T/$tag-30.exr" --budget 30 -- +WT1 2>"$T/$tag-30.log" ||
@@ -742,8 +743,21 @@ if ref=$(W=320 H=240 reference "$scene"); then
 			awk -F'\t' '$1 == 1 && $6 == 0 && $9 == 3 { f = 1 } END { exit !f }' \
 			"$T/r3.exr.work/regions.tsv"
 		judge "$T/r3.exr" "with +AM1 +A0.1 +R3"
-		check "... above +R4's" num 'a > b' "$(relmse "$T/r3.exr" "$ref")" \
-			"$(relmse "$T/r3-30.exr" "$ref")"
+		check "... above that of the run under 30 s (+R6)" num 'a > b' \
+			"$(relmse "$T/r3.exr" "$ref")" "$(relmse "$T/r3-30.exr" "$ref")"
+	fi
+	# under a budget that fits +A0.03 +R5 but not +R6 (ACC_AA_FOR_SPREAD_R5
+	# and _R6, render.c's SPREAD_DEEP_MARGIN), +R5 (on some regions +R6),
+	# which errs less than +R4 without a budget (measured 1.2e-4 against
+	# 1.7e-4)
+	if spread_level "$scene" r5 "+A0.03 +R5" "+A0.03 +R6" 1.4; then
+		check "... its regions file says so (scale 0, edges 5, or 6 on some)" \
+			awk -F'\t' '$1 == 1 && $6 == 0 && $9 == 5 { f = 1 }
+				$1 == 1 && $6 == 0 && ($9 < 5 || $9 > 6) { g = 1 }
+				END { exit !(f && !g) }' "$T/r5.exr.work/regions.tsv"
+		judge "$T/r5.exr" "with +AM1 +A0.03 +R5"
+		check "... below +R4's" num 'a < b' "$(relmse "$T/r5.exr" "$ref")" \
+			"$(relmse "$T/am1-auto.exr" "$ref")"
 	fi
 else
 	bad "thin_geometry 320x240: reference render failed"

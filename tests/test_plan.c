@@ -1210,19 +1210,24 @@ static void test_merge_aa_edges(void **state)
 		 * +R2, whatever the depth): 36 and 16 cells a subdivided pixel;
 		 * a pixel whose render pixels differ by less than the render's
 		 * threshold was not subdivided, and its spread is its error's
-		 * as it stands */
+		 * as it stands.  The deeper ones (+A0.03 +R5 and +R6, whatever
+		 * the depth): 100 and 144 cells, divided as +R4's are */
 		static const struct {
 			int edges, cells;
 			double t;
-		} light[2] = {
-			{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_R3_CELLS, ACC_AA_SPREAD_R3_THRESHOLD },
+			int light;
+		} light[4] = {
+			{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_R3_CELLS, ACC_AA_SPREAD_R3_THRESHOLD, 1 },
 			{ ACC_AA_FOR_SPREAD_FLOOR, ACC_AA_SPREAD_FLOOR_CELLS,
-			  ACC_AA_SPREAD_FLOOR_THRESHOLD },
+			  ACC_AA_SPREAD_FLOOR_THRESHOLD, 1 },
+			{ ACC_AA_FOR_SPREAD_R5, 100, ACC_AA_SPREAD_THRESHOLD, 0 },
+			{ ACC_AA_FOR_SPREAD_R6, 144, ACC_AA_SPREAD_THRESHOLD, 0 },
 		};
-		for (int li = 0; li < 2; li++) {
+		for (int li = 0; li < 4; li++) {
 			assert_true(accum_for_spread(light[li].edges));
 			const struct accum_spread sr = accum_spread_render(light[li].edges, depth);
-			assert_true(sr.light && sr.threshold == light[li].t);
+			assert_true(sr.light == light[li].light && sr.threshold == light[li].t);
+			assert_int_equal(sr.cells, light[li].cells);
 			make_acc(&spr, 5, 1, flat_value);
 			assert_int_equal(accum_merge_aa_region(&spr, &big, 0, ACC_AA, depth,
 								 light[li].edges, 0, 0, 4, 0, 1,
@@ -1248,7 +1253,8 @@ static void test_merge_aa_edges(void **state)
 				const double full = ((double)k * k + 1.0) / ((1.0 + k) * (1.0 + k)) * d;
 				const double kd = range / ACC_AA_SPREAD_RANGE * light[li].cells /
 						  accum_edge_cells(ACC_AA_SPREAD_DEPTH);
-				const double div = range < light[li].t ? 1.0 : kd > 1.0 ? kd : 1.0;
+				const double div = light[li].light && range < light[li].t ? 1.0
+						   : kd > 1.0 ? kd : 1.0;
 				/* (pixel 3's range, 0.3, is +A0.3's threshold itself:
 				 * which side the floats put it on is not the point) */
 				if (!(li == 1 && x == 3))
@@ -1259,9 +1265,11 @@ static void test_merge_aa_edges(void **state)
 						     "subdivided");
 				/* 0.06 below either threshold: not subdivided, the
 				 * spread whole; 0.9 above both: divided */
-				if (x == 2)
+				if (x == 2 && light[li].light)
 					assert_close(p[ACC_DIFF], full < v ? full : v, 1e-4, 1e-12,
 						     "below the threshold the spread whole");
+				if (x == 2 && !light[li].light)	/* 0.06: above +A0.03 */
+					assert_true(p[ACC_DIFF] < v);
 				if (x == 4)
 					assert_true(p[ACC_DIFF] < v);
 				assert_true(accum_has_scale(&spr, (size_t)x, ACC_AA_SPREAD_BIT));
@@ -2557,18 +2565,19 @@ static void test_radiosity_trace(void **state)
 /* 7. The regions file round-trips; a bad line is reported with its number. */
 static void test_regions_file(void **state)
 {
-	struct plan_region rs[6] = {
+	struct plan_region rs[7] = {
 		{ 0, 0, 7, 7, 2, 10, 1.0, 0.1, 0, 0, 0 },
 		{ 12, 30, 40, 47, 4, 3, 0.5, 0.2, 0, 0, 0 },
 		{ 63, 47, 63, 47, ACC_AA, 1, 0.1, 0.3, ACC_GRID_FRAME, 3, ACC_AA_FOR_EDGES },
 		{ 8, 0, 15, 7, ACC_AA, 1, 0.1, 0.3, ACC_GRID_FRAME, 3, ACC_AA_FOR_SPREAD },
 		{ 16, 0, 23, 7, ACC_AA, 1, 0.1, 0.3, ACC_GRID_FRAME, 3, ACC_AA_FOR_SPREAD_R3 },
 		{ 24, 0, 31, 7, ACC_AA, 1, 0.1, 0.3, ACC_GRID_FRAME, 2, ACC_AA_FOR_SPREAD_FLOOR },
+		{ 32, 0, 39, 7, ACC_AA, 1, 0.1, 0.3, ACC_GRID_FRAME, 3, ACC_AA_FOR_SPREAD_R6 },
 	};
 	static char o0[] = "r0.exr", o1[] = "a dir/with spaces/region 1.exr",
 		o2[] = "/tmp/x y\tz 4\t1.exr", o3[] = "p1-r3-aa.exr", o4[] = "p1-r4-aa.exr",
-		o5[] = "p1-r5-aa.exr";
-	char *outs[6] = { o0, o1, o2, o3, o4, o5 };
+		o5[] = "p1-r5-aa.exr", o6[] = "p1-r6-aa.exr";
+	char *outs[7] = { o0, o1, o2, o3, o4, o5, o6 };
 	struct plan pl;
 	struct plan_region *got;
 	char **gout, path[256], err[512];
@@ -2579,15 +2588,15 @@ static void test_regions_file(void **state)
 	(void)state;
 	memset(&pl, 0, sizeof(pl));
 	pl.regions = rs;
-	pl.nregions = 6;
+	pl.nregions = 7;
 	scratch(path, sizeof(path), "regions file.txt");
 	f = fopen(path, "w");
 	assert_non_null(f);
 	assert_int_equal(plan_regions_write(f, &pl, 7, outs), 0);
 	assert_int_equal(fclose(f), 0);
 	assert_int_equal(plan_regions_read(path, &got, &gout, &passes, &n, err, sizeof(err)), 0);
-	assert_int_equal(n, 6);
-	for (size_t k = 0; k < 6; k++) {
+	assert_int_equal(n, 7);
+	for (size_t k = 0; k < 7; k++) {
 		assert_int_equal(passes[k], 7);
 		assert_int_equal(got[k].x0, rs[k].x0);
 		assert_int_equal(got[k].y0, rs[k].y0);
@@ -2623,7 +2632,7 @@ static void test_regions_file(void **state)
 
 	/* line 3 has a letter for y0; then a line without an output; then,
 	 * under the header naming depth and edges, lines without them, with
-	 * a depth out of range, with edges on a scaled region, with edges 5 */
+	 * a depth out of range, with edges on a scaled region, with edges 7 */
 #define HDR "# povpress regions: pass x0 y0 x1 y1 scale output depth edges\n"
 	static const char *const bad[] = {
 		"# header\n1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\tx\t3\t3\t2\tb.exr\t0\t0\n",
@@ -2631,7 +2640,7 @@ static void test_regions_file(void **state)
 		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t1\n1\t0\t0\t3\t3\t2\tb.exr\n",
 		HDR "1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\t0\t3\t3\t0\tb.exr\t6\t0\n",
 		HDR "\n1\t0\t0\t3\t3\t2\ta.exr\t3\t1\n",
-		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t0\n1\t0\t0\t3\t3\t0\tb.exr\t4\t5\n",
+		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t0\n1\t0\t0\t3\t3\t0\tb.exr\t4\t7\n",
 		/* a sign; no header at all, old-format lines */
 		HDR "1\t0\t0\t3\t3\t0\ta.exr\t4\t0\n1\t0\t0\t3\t3\t0\tb.exr\t+4\t0\n",
 		"# x\n1\t0\t0\t3\t3\t2\ta.exr\t0\t0\n1\t0\t0\t3\t3\t2\tb.exr\n",
@@ -2749,13 +2758,17 @@ static void test_plan_job(void **state)
 			int edges, cells, want_cells;
 			const char *a, *rr;
 			double t;
-		} light[2] = {
+		} light[4] = {
 			{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_R3_CELLS, 4 * 3 * 3, "+A0.1", "+R3",
 			  ACC_AA_SPREAD_R3_THRESHOLD },
 			{ ACC_AA_FOR_SPREAD_FLOOR, ACC_AA_SPREAD_FLOOR_CELLS, 4 * 2 * 2, "+A0.3", "+R2",
 			  ACC_AA_SPREAD_FLOOR_THRESHOLD },
+			{ ACC_AA_FOR_SPREAD_R5, 4 * ACC_AA_SPREAD_R5_SIDE * ACC_AA_SPREAD_R5_SIDE,
+			  4 * 5 * 5, "+A0.03", "+R5", ACC_AA_SPREAD_THRESHOLD },
+			{ ACC_AA_FOR_SPREAD_R6, 4 * ACC_AA_SPREAD_R6_SIDE * ACC_AA_SPREAD_R6_SIDE,
+			  4 * 6 * 6, "+A0.03", "+R6", ACC_AA_SPREAD_THRESHOLD },
 		};
-		for (int li = 0; li < 2; li++) {
+		for (int li = 0; li < 4; li++) {
 			r.edges = light[li].edges;
 			plan_job(&base, &r, "out/a4.exr", &region, aextra, &job);
 			assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
