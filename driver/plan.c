@@ -1320,7 +1320,8 @@ int plan_regions_write(FILE *f, const struct plan *pl, int pass, char *const *ou
 {
 	fprintf(f, "%s (pixels 0-based, inclusive; depth and edges: an antialiased render "
 		"in scale 2's place, its +R, and 1 if taken for edges, 2 for spread error (+AM1), "
-		"3 at +A0.1 +R3 and 4 at +A0.3 +R2, 0 for a few pixels; else 0 0)\n",
+		"3 at +A0.1 +R3, 4 at +A0.3 +R2, 5 and 6 at +A0.03 +R5 and +R6, 0 for a few "
+		"pixels; else 0 0)\n",
 		REGIONS_HEADER);
 	for (size_t k = 0; k < pl->nregions; k++)
 		if (strchr(outputs[k], '\n'))

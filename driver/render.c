@@ -2209,19 +2209,22 @@ static const struct spread_level {
 };
 enum { NSPREAD = sizeof spread_levels / sizeof spread_levels[0], SPREAD_R4 = 2 };
 /*
- * The margin of the deeper levels, +R6 and +R5, which are taken whole or
- * not at all (no region of a pass moves up to them: spread_mix() mixes
- * only the levels below +R4 with the one above).  A deeper pass takes
+ * The margin of the deeper levels, +R6 and +R5.  No region of a pass that
+ * fits +R4 but not +R5 whole moves up to +R5 (spread_mix() mixes the
+ * levels from +R4 down, and +R5 whole with +R6).  A deeper pass takes
  * most of the budget, and a render of it stopped at the deadline keeps
- * only its finished blocks: with SPREAD_MARGIN and the moves, Debian's
+ * only its finished blocks: with SPREAD_MARGIN and every move, Debian's
  * var_refl at 640x480 under --budget 12 took +R5 on two regions and +R6
  * on three, and one run in four ended at relMSE 4.3e-4 against 3.7e-5
  * (the pass's POV-Ray CPU over its price at +R6 whole, --budget 40
  * --max-passes 1: var_refl 1.26, thin_geometry 1.25, soft_shadows 1.10,
  * granite 1.05, noise_generator 0.86, swirlbox 0.69; 2026-12-05 12:30
- * UTC); with this margin and the moves, under --budget 6 soft_shadows and
- * swirlbox moved regions to +R5 where later passes had done better (1.21
- * and 1.17 times the relMSE) and var_refl lost a render in one run of two.
+ * UTC); with this margin and every move, under --budget 6 soft_shadows
+ * and swirlbox moved regions from +R4 to +R5 where later passes had done
+ * better (1.21 and 1.17 times the relMSE) and var_refl lost a render in
+ * one run of two.  The moves from +R5 to +R6 alone: by turns under 12 s
+ * (three runs each, 13:19 to 13:25 UTC) var_refl 0.82, swirlbox 0.88,
+ * noise_generator 0.93, soft_shadows 1.02 times the relMSE.
  */
 #define SPREAD_DEEP_MARGIN 1.4
 /* The place in spread_levels of the render of edges and depth (NSPREAD
@@ -2427,7 +2430,7 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 		while (t < NSPREAD &&
 		       !fits(level_margin(t), sums[t], worst[t], pp, left))
 			t++;
-		mix = t > SPREAD_R4;
+		mix = t > 0 && t != SPREAD_R4;	/* see SPREAD_DEEP_MARGIN */
 	}
 	/* each scale-2 region's level: t, or t - 1 where spread_mix() so
 	 * chose */
