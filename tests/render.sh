@@ -932,6 +932,18 @@ check "... its antialiased regions for a few pixels at +R5 (scale 0, depth 5, ed
 	awk -F'\t' '!/^#/ && $6 == 0 { k++; if ($8 != 5 || $9 != 0) b = 1 } END { exit b || !k }' \
 	"$T/af5.work/regions.tsv"
 folds_alike af5
+# ... and the deeper render for spread error of spread_level's r5 run above
+# (+A0.03 +R5, edges 5; +R6, 6, on any region moved up)
+if [[ -f $T/r5.exr.work/regions.tsv ]]; then
+	"$PP" merge --init "$T/r5.exr.work/base.exr" -o "$T/r5m-acc0.exr" &&
+		"$PP" merge "$T/r5m-acc0.exr" "$T/r5.exr.work/regions.tsv" -o "$T/r5m-acc1.exr" \
+			>/dev/null
+	check "thin_geometry's pass at +R5 (320x240): merge its regions.tsv: runs" test $? -eq 0
+	mkdir -p "$T/r5m.work" && cp "$T/r5.exr.work/accum.exr" "$T/r5m.work/"
+	folds_alike r5m
+else
+	bad "thin_geometry's pass at +R5: no work directory to merge"
+fi
 differ() { ! idiff -fail 0 -failpercent 0 "$@" >/dev/null; }
 # the same regions in the format before depth and edges: folded as +R4 for a few
 # pixels, which differs (so the columns are what made the fold above right)
