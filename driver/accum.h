@@ -254,13 +254,15 @@ enum {
  * twice the size (their depth column is ignored), a subdivided pixel 2 x 2
  * render pixels of 5 x 5 or 6 x 6 samples.  POV-Ray alone at 1280x960,
  * box-averaged to 640x480 against the sweep's references at scale 9 (one
- * run each, CPU s and relMSE, 2026-12-05 12:55 UTC): Debian's
+ * run each, CPU s and relMSE, 2026-12-05 12:19 to 12:22 UTC): Debian's
  * noise_generator at +R3 to +R6 2.1e-5 in 4.0 s, 8.8e-6 in 6.3, 4.8e-6 in
- * 9.2, 2.9e-6 in 13.1 (relMSE times CPU falling 8.2e-5, 5.5e-5, 4.3e-5,
- * 3.8e-5), granite at +R4 and +R5 4.2e-5 in 13.5 and 2.5e-5 in 20.0;
- * soft_shadows and thin_geometry alike at every depth (relMSE times CPU
- * 2.1e-4 to 2.4e-4 and 5.2e-4 to 5.9e-4).  POV-Ray's sweep goes no deeper
- * than +R4, where later passes on textures bought little.
+ * 9.2, 2.9e-6 in 13.1 (relMSE times CPU falling 8.3e-5, 5.5e-5, 4.4e-5,
+ * 3.8e-5), var_refl 1.35e-3 to 8.7e-4 the same way, granite at +R4 and +R5
+ * 4.2e-5 in 13.5 and 2.5e-5 in 20.0; soft_shadows and thin_geometry alike
+ * at every depth (relMSE times CPU 2.1e-4 to 2.4e-4 and 5.2e-4 to
+ * 5.9e-4).  POV-Ray's sweep goes no deeper than +R4, where later passes on
+ * textures bought little.  README, "Deeper renders for spread error under
+ * a larger budget", has the figures.
  */
 #define ACC_AA_SPREAD_R5_SIDE 5
 #define ACC_AA_SPREAD_R6_SIDE 6

@@ -2223,7 +2223,7 @@ enum { NSPREAD = sizeof spread_levels / sizeof spread_levels[0], SPREAD_R4 = 2 }
  * and swirlbox moved regions from +R4 to +R5 where later passes had done
  * better (1.21 and 1.17 times the relMSE) and var_refl lost a render in
  * one run of two.  The moves from +R5 to +R6 alone: by turns under 12 s
- * (three runs each, 13:19 to 13:25 UTC) var_refl 0.82, swirlbox 0.88,
+ * (three runs each, 13:19 to 13:24 UTC) var_refl 0.82, swirlbox 0.88,
  * noise_generator 0.93, soft_shadows 1.02 times the relMSE.
  */
 #define SPREAD_DEEP_MARGIN 1.4
