@@ -38,9 +38,9 @@ cmpval() { # cmpval OUTPUT KEY: value printed by compare
 echo "# povpress end-to-end tests in $T"
 
 # --- the command line ------------------------------------------------------
-check "povpress --help exits 0" "$PP" --help >/dev/null
-check "analyze --help exits 0" "$PP" analyze --help >/dev/null
-check "compare --help exits 0" "$PP" compare --help >/dev/null
+check "povpress --help exits 0" quiet "$PP" --help
+check "analyze --help exits 0" quiet "$PP" analyze --help
+check "compare --help exits 0" quiet "$PP" compare --help
 "$PP" analyze --order 7 x.exr -o y.exr 2>/dev/null
 check "bad --order is a usage error (2)" test $? -eq 2
 "$PP" frobnicate 2>/dev/null

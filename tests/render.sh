@@ -92,7 +92,7 @@ echo "# povpress render tests in $T"
 
 # --- usage -------------------------------------------------------------------
 for c in render plan merge; do
-	check "$c --help exits 0" "$PP" $c --help >/dev/null
+	check "$c --help exits 0" quiet "$PP" $c --help
 done
 "$PP" render 2>/dev/null
 check "render without a scene is a usage error (2)" test $? -eq 2
@@ -855,7 +855,7 @@ check "plan's regions are render's regions" \
 	cmp -s <(cut -f1-6 "$T/farm/jobs/regions.tsv") <(cut -f1-6 "$T/one.work/regions.tsv")
 oiiotool "$T/farm/acc1.exr" --ch R,G,B -o "$T/farm/img1.exr" 2>/dev/null
 check "plan -> xargs -> merge gives render's image, bit for bit" \
-	idiff -fail 0 -failpercent 0 "$T/farm/img1.exr" "$T/one.exr" >/dev/null
+	same "$T/farm/img1.exr" "$T/one.exr"
 
 # --- merge folds grid renders (scale 4 and up) as render does ---------------
 gm=(render "$scene" -o "$T/gm.exr" -W 48 -H 36 --jobs 1 --target 1e-4 -q --keep-workdir
@@ -912,7 +912,7 @@ folds_alike() {
 			2>/dev/null
 	done
 	check "... merge folds it to render's accumulation, bit for bit" \
-		idiff -fail 0 -failpercent 0 "$T/$1-acc1-ch.exr" "$T/$1.work-accum-ch.exr" >/dev/null
+		same "$T/$1-acc1-ch.exr" "$T/$1.work-accum-ch.exr"
 }
 for n in r4 r3; do
 	o=()
