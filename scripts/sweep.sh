@@ -54,7 +54,9 @@
 #             2026-12-04: on hdr_highlights +AM2 +A0.1 +R4 so had relMSE
 #             1.1e-4 in 1.07 CPU s, where the envelope without it had 5.2e-4
 #             at that CPU; +AM1 at +R4 since povpress renders spread error
-#             so, README); --quick +AM1 +A0.1 +R3, +AM1 +A0.03 +R4 and
+#             so, README), +AM1 +A0.03 +R{5,6} (since 2026-12-05, when
+#             povpress's first pass began to take them under a budget);
+#             --quick +AM1 +A0.1 +R3, +AM1 +A0.03 +R{4,5,6} and
 #             +AM2 +A0.3 +R3
 #   povpress  `povpress render` at --target 3e-3, 1e-3, 3e-4, 1e-4 and at
 #             --budget 2, 4, 8 seconds (with --target 1e-6), its defaults;
@@ -165,7 +167,8 @@ if ((quick)); then
 	REF_S=9 CHK_S=5 TRD_S=3
 	THRESHOLDS=(0.3 0.03 0.0)
 	DEPTHS=(2 3)
-	AA2X=("+AM1 +A0.1 +R3" "+AM1 +A0.03 +R4" "+AM2 +A0.3 +R3")
+	AA2X=("+AM1 +A0.1 +R3" "+AM1 +A0.03 +R4" "+AM1 +A0.03 +R5" "+AM1 +A0.03 +R6"
+	      "+AM2 +A0.3 +R3")
 	TARGETS=(3e-3 1e-3)
 	PP_BUDGETS=(3)
 else
@@ -173,7 +176,8 @@ else
 	THRESHOLDS=(0.3 0.1 0.03 0.01 0.0)
 	DEPTHS=(2 3 4)
 	AA2X=("+AM1 +A0.1 +R3" "+AM1 +A0.03 +R3" "+AM1 +A0.1 +R4" "+AM1 +A0.03 +R4"
-	      "+AM2 +A0.3 +R3" "+AM2 +A0.1 +R3" "+AM2 +A0.1 +R4")
+	      "+AM1 +A0.03 +R5" "+AM1 +A0.03 +R6" "+AM2 +A0.3 +R3" "+AM2 +A0.1 +R3"
+	      "+AM2 +A0.1 +R4")
 	TARGETS=(3e-3 1e-3 3e-4 1e-4)
 	PP_BUDGETS=(2 4 8)
 fi
