@@ -2215,14 +2215,15 @@ enum { NSPREAD = sizeof spread_levels / sizeof spread_levels[0], SPREAD_R4 = 2 }
  * most of the budget, and a render of it stopped at the deadline keeps
  * only its finished blocks: with SPREAD_MARGIN and every move, Debian's
  * var_refl at 640x480 under --budget 12 took +R5 on two regions and +R6
- * on three, and one run in four ended at relMSE 4.3e-4 against 3.7e-5
- * (the pass's POV-Ray CPU over its price at +R6 whole, --budget 40
- * --max-passes 1: var_refl 1.26, thin_geometry 1.25, soft_shadows 1.10,
- * granite 1.05, noise_generator 0.86, swirlbox 0.69; 2026-12-05 12:30
- * UTC); with this margin and every move, under --budget 6 soft_shadows
- * and swirlbox moved regions from +R4 to +R5 where later passes had done
- * better (1.21 and 1.17 times the relMSE) and var_refl lost a render in
- * one run of two.  The moves from +R5 to +R6 alone: by turns under 12 s
+ * on three, and one run of two by turns ended at relMSE 4.3e-4 against
+ * 3.7e-5, likely a render stopped at the deadline (the pass's POV-Ray CPU
+ * over its price at +R6 whole, --budget 40 --max-passes 1: var_refl 1.26,
+ * thin_geometry 1.25, soft_shadows 1.10, granite 1.05, noise_generator
+ * 0.86, swirlbox 0.69; 2026-12-05 12:30 UTC); with this margin and every
+ * move, under --budget 6, where the moves from +R4 to +R5 were the only
+ * difference, soft_shadows and swirlbox erred 1.21 and 1.17 times as much
+ * (later passes had done better) and var_refl ended at 3.5e-4 against
+ * 1.1e-4 in one run of two.  The moves from +R5 to +R6 alone: by turns under 12 s
  * (three runs each, 13:19 to 13:24 UTC) var_refl 0.82, swirlbox 0.88,
  * noise_generator 0.93, soft_shadows 1.02 times the relMSE.
  */
