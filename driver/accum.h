@@ -248,6 +248,8 @@ enum {
  * may leave a step of up to 0.3 between two of its pixels charged as 0.1.
  */
 #define ACC_AA_SPREAD_FLOOR_THRESHOLD 0.3
+#define ACC_AA_SPREAD_FLOOR_SIDE 2
+#define ACC_AA_SPREAD_FLOOR_CELLS (4 * ACC_AA_SPREAD_FLOOR_SIDE * ACC_AA_SPREAD_FLOOR_SIDE)
 /*
  * The deeper renders for spread error (ACC_AA_FOR_SPREAD_R5 and _R6), for
  * a budget that fits more than +A0.03 +R4: +AM1 +A0.03 +R5 or +R6 +J at
@@ -260,14 +262,12 @@ enum {
  * 3.8e-5), var_refl 1.35e-3 to 8.7e-4 the same way, granite at +R4 and +R5
  * 4.2e-5 in 13.5 and 2.5e-5 in 20.0; soft_shadows and thin_geometry alike
  * at every depth (relMSE times CPU 2.1e-4 to 2.4e-4 and 5.2e-4 to
- * 5.9e-4).  POV-Ray's sweep goes no deeper than +R4, where later passes on
+ * 5.9e-4).  The issue's sweep went no deeper than +R4, where later passes on
  * textures bought little.  README, "Deeper renders for spread error under
  * a larger budget", has the figures.
  */
 #define ACC_AA_SPREAD_R5_SIDE 5
 #define ACC_AA_SPREAD_R6_SIDE 6
-#define ACC_AA_SPREAD_FLOOR_SIDE 2
-#define ACC_AA_SPREAD_FLOOR_CELLS (4 * ACC_AA_SPREAD_FLOOR_SIDE * ACC_AA_SPREAD_FLOOR_SIDE)
 
 /* Whether a render in scale 2's place was taken for spread error (+AM1). */
 static inline int accum_for_spread(int edges)

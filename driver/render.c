@@ -2207,6 +2207,7 @@ static const struct spread_level {
 	{ ACC_AA_FOR_SPREAD, 2 },
 	{ ACC_AA_FOR_SPREAD_FLOOR, 2 },
 };
+/* NSPREAD levels, +A0.03 +R4 the one at SPREAD_R4 */
 enum { NSPREAD = sizeof spread_levels / sizeof spread_levels[0], SPREAD_R4 = 2 };
 /*
  * The margin of the deeper levels, +R6 and +R5.  No region of a pass that
@@ -2223,9 +2224,9 @@ enum { NSPREAD = sizeof spread_levels / sizeof spread_levels[0], SPREAD_R4 = 2 }
  * move, under --budget 6, where the moves from +R4 to +R5 were the only
  * difference, soft_shadows and swirlbox erred 1.21 and 1.17 times as much
  * (later passes had done better) and var_refl ended at 3.5e-4 against
- * 1.1e-4 in one run of two.  The moves from +R5 to +R6 alone: by turns under 12 s
- * (three runs each, 13:19 to 13:24 UTC) var_refl 0.82, swirlbox 0.88,
- * noise_generator 0.93, soft_shadows 1.02 times the relMSE.
+ * 1.1e-4 in one run of two.  The moves from +R5 to +R6 alone: by turns
+ * under 12 s (three runs each, 13:19 to 13:24 UTC) var_refl 0.82, swirlbox
+ * 0.88, noise_generator 0.93, soft_shadows 1.02 times the relMSE.
  */
 #define SPREAD_DEEP_MARGIN 1.4
 /* The place in spread_levels of the render of edges and depth (NSPREAD
@@ -2356,7 +2357,7 @@ static double spread_mix(const struct plan *pl, const struct plan_params *pp, do
 			 int slots, double lat, const double *price, const double sums[NSPREAD],
 			 int t, unsigned char *up)
 {
-	const double m = t < NSPREAD ? level_margin(t) : SPREAD_MARGIN;
+	const double m = level_margin(t);	/* t - 1's too: see spread_am1()'s mix */
 	double total = m * (t < NSPREAD ? sums[t] : pl->cost);
 	struct mix_cand *c = malloc(pl->nregions * sizeof(*c));
 	if (!c)
@@ -2431,7 +2432,9 @@ static size_t spread_am1(const struct run *r, struct plan *pl, const struct plan
 		while (t < NSPREAD &&
 		       !fits(level_margin(t), sums[t], worst[t], pp, left))
 			t++;
-		mix = t > 0 && t != SPREAD_R4;	/* see SPREAD_DEEP_MARGIN */
+		/* moves up to t - 1 at t's margin, never from +R4 to the
+		 * deeper levels (see SPREAD_DEEP_MARGIN) */
+		mix = t > 0 && t != SPREAD_R4;
 	}
 	/* each scale-2 region's level: t, or t - 1 where spread_mix() so
 	 * chose */
@@ -2710,8 +2713,8 @@ static void aa_progress(struct run *r, int pass, const struct plan *pl, size_t n
 	char how[2][32], all[96];
 	for (int l = 0; l < nl; l++) {
 		const struct accum_spread sp = accum_spread_render(lv[l].edges, lv[l].depth);
-		if (accum_for_spread(lv[l].edges) &&
-		    (sp.light || nl > 1 || lv[l].edges != ACC_AA_FOR_SPREAD))
+		/* by depth only the +A0.03 render at a depth of its own */
+		if (accum_for_spread(lv[l].edges) && (nl > 1 || lv[l].edges != ACC_AA_FOR_SPREAD))
 			snprintf(how[l], sizeof(how[l]), "%s %s", sp.a, sp.r);
 		else
 			snprintf(how[l], sizeof(how[l]), "depth %d", lv[l].depth);

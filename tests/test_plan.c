@@ -1216,7 +1216,7 @@ static void test_merge_aa_edges(void **state)
 			int edges, cells;
 			double t;
 			int light;
-		} light[4] = {
+		} lv[4] = {
 			{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_R3_CELLS, ACC_AA_SPREAD_R3_THRESHOLD, 1 },
 			{ ACC_AA_FOR_SPREAD_FLOOR, ACC_AA_SPREAD_FLOOR_CELLS,
 			  ACC_AA_SPREAD_FLOOR_THRESHOLD, 1 },
@@ -1224,23 +1224,23 @@ static void test_merge_aa_edges(void **state)
 			{ ACC_AA_FOR_SPREAD_R6, 144, ACC_AA_SPREAD_THRESHOLD, 0 },
 		};
 		for (int li = 0; li < 4; li++) {
-			assert_true(accum_for_spread(light[li].edges));
-			const struct accum_spread sr = accum_spread_render(light[li].edges, depth);
-			assert_true(sr.light == light[li].light && sr.threshold == light[li].t);
-			assert_int_equal(sr.cells, light[li].cells);
+			assert_true(accum_for_spread(lv[li].edges));
+			const struct accum_spread sr = accum_spread_render(lv[li].edges, depth);
+			assert_true(sr.light == lv[li].light && sr.threshold == lv[li].t);
+			assert_int_equal(sr.cells, lv[li].cells);
 			make_acc(&spr, 5, 1, flat_value);
 			assert_int_equal(accum_merge_aa_region(&spr, &big, 0, ACC_AA, depth,
-								 light[li].edges, 0, 0, 4, 0, 1,
+								 lv[li].edges, 0, 0, 4, 0, 1,
 								 &folded, err, sizeof(err)), 0);
 			assert_int_equal(folded, 5);
 			for (int x = 0; x < 5; x++) {
 				const float *p = accpx(&spr, (size_t)x);
 				const double range = 3.0 * spread[x];
-				const double ek = edge_cells_want(range, light[li].cells);
+				const double ek = edge_cells_want(range, lv[li].cells);
 				const int k = ek > ACC_AA_FIRST ? (int)lround(ek) : ACC_AA_FIRST;
 				assert_true(p[ACC_SAMPLES] == (float)(1 + k));
 				if (range >= ACC_AA_THRESHOLD)
-					assert_int_equal(k, light[li].cells);
+					assert_int_equal(k, lv[li].cells);
 				double d = 0.0, v = 0.0;
 				for (int c = 0; c < 3; c++) {
 					const double m = 0.4 + 0.1 * c;
@@ -1251,9 +1251,9 @@ static void test_merge_aa_edges(void **state)
 					v += spread[x] * spread[x] / 3.0 / 4.0 / den / 3.0;
 				}
 				const double full = ((double)k * k + 1.0) / ((1.0 + k) * (1.0 + k)) * d;
-				const double kd = range / ACC_AA_SPREAD_RANGE * light[li].cells /
+				const double kd = range / ACC_AA_SPREAD_RANGE * lv[li].cells /
 						  accum_edge_cells(ACC_AA_SPREAD_DEPTH);
-				const double div = light[li].light && range < light[li].t ? 1.0
+				const double div = lv[li].light && range < lv[li].t ? 1.0
 						   : kd > 1.0 ? kd : 1.0;
 				/* (pixel 3's range, 0.3, is +A0.3's threshold itself:
 				 * which side the floats put it on is not the point) */
@@ -1265,10 +1265,10 @@ static void test_merge_aa_edges(void **state)
 						     "subdivided");
 				/* 0.06 below either threshold: not subdivided, the
 				 * spread whole; 0.9 above both: divided */
-				if (x == 2 && light[li].light)
+				if (x == 2 && lv[li].light)
 					assert_close(p[ACC_DIFF], full < v ? full : v, 1e-4, 1e-12,
 						     "below the threshold the spread whole");
-				if (x == 2 && !light[li].light)	/* 0.06: above +A0.03 */
+				if (x == 2 && !lv[li].light)	/* 0.06: above +A0.03 */
 					assert_true(p[ACC_DIFF] < v);
 				if (x == 4)
 					assert_true(p[ACC_DIFF] < v);
@@ -2758,7 +2758,7 @@ static void test_plan_job(void **state)
 			int edges, cells, want_cells;
 			const char *a, *rr;
 			double t;
-		} light[4] = {
+		} lv[4] = {
 			{ ACC_AA_FOR_SPREAD_R3, ACC_AA_SPREAD_R3_CELLS, 4 * 3 * 3, "+A0.1", "+R3",
 			  ACC_AA_SPREAD_R3_THRESHOLD },
 			{ ACC_AA_FOR_SPREAD_FLOOR, ACC_AA_SPREAD_FLOOR_CELLS, 4 * 2 * 2, "+A0.3", "+R2",
@@ -2769,12 +2769,12 @@ static void test_plan_job(void **state)
 			  4 * 6 * 6, "+A0.03", "+R6", ACC_AA_SPREAD_THRESHOLD },
 		};
 		for (int li = 0; li < 4; li++) {
-			r.edges = light[li].edges;
+			r.edges = lv[li].edges;
 			plan_job(&base, &r, "out/a4.exr", &region, aextra, &job);
 			assert_job_frame(&job, &region, 128, 96, 6, 4, 21, 15);
-			assert_aa_options(&job, "+AM1", light[li].a, light[li].rr, "+J");
-			assert_true(fabs(strtod(light[li].a + 2, NULL) - light[li].t) < 1e-12);
-			assert_int_equal(light[li].cells, light[li].want_cells);
+			assert_aa_options(&job, "+AM1", lv[li].a, lv[li].rr, "+J");
+			assert_true(fabs(strtod(lv[li].a + 2, NULL) - lv[li].t) < 1e-12);
+			assert_int_equal(lv[li].cells, lv[li].want_cells);
 		}
 		r.edges = ACC_AA_FOR_FEW;
 	}
