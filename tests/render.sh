@@ -904,15 +904,16 @@ one_pass() {
 		"$PP" merge "$T/$tag-acc0.exr" "$T/$tag.work/regions.tsv" -o "$T/$tag-acc1.exr" \
 			>/dev/null
 }
-# folds_alike TAG: check that one_pass TAG's merge equals render's accumulation
+# folds_alike TAG [ACCUM]: check that one_pass TAG's merge, $T/TAG-acc1.exr,
+# equals render's accumulation, $T/ACCUM.exr (default TAG.work/accum)
 folds_alike() {
-	local f
-	for f in "$1-acc1" "$1.work/accum"; do
+	local f acc=${2:-$1.work/accum}
+	for f in "$1-acc1" "$acc"; do
 		oiiotool "$T/$f.exr" --ch R,G,B,samples,scales,diff,var.R -o "$T/${f//\//-}-ch.exr" \
 			2>/dev/null
 	done
 	check "... merge folds it to render's accumulation, bit for bit" \
-		same "$T/$1-acc1-ch.exr" "$T/$1.work-accum-ch.exr"
+		same "$T/$1-acc1-ch.exr" "$T/${acc//\//-}-ch.exr"
 }
 for n in r4 r3; do
 	o=()
@@ -939,8 +940,7 @@ if [[ -f $T/r5.exr.work/regions.tsv ]]; then
 		"$PP" merge "$T/r5m-acc0.exr" "$T/r5.exr.work/regions.tsv" -o "$T/r5m-acc1.exr" \
 			>/dev/null
 	check "thin_geometry's pass at +R5 (320x240): merge its regions.tsv: runs" test $? -eq 0
-	mkdir -p "$T/r5m.work" && cp "$T/r5.exr.work/accum.exr" "$T/r5m.work/"
-	folds_alike r5m
+	folds_alike r5m r5.exr.work/accum
 else
 	bad "thin_geometry's pass at +R5: no work directory to merge"
 fi
